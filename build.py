@@ -1,0 +1,360 @@
+"""Build, post-process and validate the project's FMUs.
+
+    python build.py                 # builds every FMU in FMU_SPECS into models/
+    python build.py --dest /tmp/x   # elsewhere
+
+For each spec: PythonFMU builds the zip; then modelDescription.xml inside it is
+post-processed (units with <UnitDefinitions>, min/max of bounded variables, a complete
+<ModelStructure>, capability flags) and documentation/index.html is added. Finally the FMU is
+validated with fmpy and `fmutool -check`; the script exits non-zero on any problem.
+
+To add an FMU (e.g. Drivetrain), append an FmuSpec to FMU_SPECS: its script must define a
+``VARIABLE_META`` dict {name: (unit, min, max)} next to the Fmi2Slave class.
+"""
+
+from __future__ import annotations
+
+import argparse
+import html
+import importlib.util
+import io
+import shutil
+import subprocess
+import sys
+import tempfile
+import zipfile
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from xml.dom.minidom import parseString
+from xml.etree import ElementTree as ET
+
+ROOT = Path(__file__).resolve().parent
+
+# unit name -> exponents of the SI base units (kg, m, s, A, K, mol, cd, rad)
+BASE_UNITS: dict[str, dict[str, int]] = {
+    "1": {},
+    "kg": {"kg": 1},
+    "m": {"m": 1},
+    "s": {"s": 1},
+    "rad": {"rad": 1},
+    "m/s": {"m": 1, "s": -1},
+    "m/s2": {"m": 1, "s": -2},
+    "rad/s": {"rad": 1, "s": -1},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "N.s": {"kg": 1, "m": 1, "s": -1},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "N/m": {"kg": 1, "s": -2},
+    "N.s/m": {"kg": 1, "s": -1},
+    "J": {"kg": 1, "m": 2, "s": -2},
+}
+
+
+@dataclass(frozen=True)
+class FmuSpec:
+    """One FMU of the project."""
+
+    name: str                                   # model identifier = class name = FMU name
+    script: Path                                # PythonFMU script (relative to ROOT)
+    project_dirs: tuple[Path, ...] = ()         # copied to resources/<dir name>/
+    options: dict[str, bool] = field(default_factory=dict)  # FMI2 CoSimulation flags
+    equations_html: str = ""                    # extra HTML for documentation/index.html
+
+
+ROTOR_EQUATIONS = """
+<h2>Equations (MODEL.md &sect;1, outputs for a system model)</h2>
+<p>Position z = x + i y (inertial frame), spin angle &psi; with &psi;' = &Omega;.
+Free flight while |z| &lt; c<sub>r</sub>:</p>
+<pre>m z'' = a (F_bias &minus; c z' &minus; k z)
+        + m e_c &Omega;&sup2; exp(i(&psi; + &phi;)) + F_ext,
+F_bias = +i m g (levitate = true),  F_ext = F_x + i F_y &minus; i m g,  a = amb_on</pre>
+<p>&Omega;, F_ext and a are held constant over a communication step; the flow is then
+propagated in closed form (no time-discretisation error). The term
+i m e_c &Omega;' exp(i(&psi;+&phi;)) from a changing speed is left out.</p>
+<p>Impact at |z| = c<sub>r</sub> with &rdot;<sup>&minus;</sup> &gt; 0, n = z/|z|,
+s = sign(v_rel), v_rel = R &Omega; + c<sub>r</sub> &theta;':</p>
+<pre>z'+ = z'- &minus; (1 + d) rdot- (1 + i &mu; s) n</pre>
+<p>(friction impulse capped at stick, v_rel = 0). Sustained contact on the circle
+z = c<sub>r</sub> e<sup>i&theta;</sup> with F the sum of all non-contact forces:</p>
+<pre>N = Re(e^{-i&theta;} F) + m c_r &theta;'&sup2;
+m c_r &theta;'' = Im(e^{-i&theta;} F) &minus; F_t
+sliding: F_t = &mu; s N;   rolling: &theta;' = &minus;R &Omega;/c_r, |F_t| &le; &mu; N</pre>
+<h3>Outputs (each force/torque averaged over the step; an impulse P in a step h counts as
+P/h)</h3>
+<ul>
+<li>F_bx, F_by: bearing (contact) force on the rotor; the housing feels the opposite.
+P_n: normal impulse in the step; F_n_peak: peak normal force.</li>
+<li>T_f = &minus;R F_t (sliding, rolling) &minus; R P_t/h (impulses); negative when it brakes a
+positive spin.</li>
+<li>F_amb_x, F_amb_y = a (F_bias &minus; c z' &minus; k z) at the end of the step.</li>
+<li>x, y, vx, vy; U = z e<sup>&minus;i&psi;</sup>/c<sub>r</sub> (u_re, u_im) and dU/dt with
+t = &Omega; &tau; (du_re, du_im; 0 when &Omega; = 0); r_rel = r/c<sub>r</sub>; whirl_rate =
+&theta;'; v_rel.</li>
+<li>mode (0 free, 1 sliding, 2 rolling), in_contact = (mode &ne; 0), n_impacts (total),
+n_impacts_step, t_last_impact, v_last_impact (rdot&minus; of the last impact, 0 before any),
+E_diss = &sum; [&frac12; m (1&minus;d&sup2;) rdot&minus;&sup2; + P_t (v_rel&minus; + v_rel+)/2]
++ &int; &mu; N |v_rel| dt.</li>
+</ul>
+"""
+
+FMU_SPECS: tuple[FmuSpec, ...] = (
+    FmuSpec(
+        name="RotorTouchdown",
+        script=Path("fmu_src/RotorTouchdown.py"),
+        project_dirs=(Path("fmu_src/rotortd"),),
+        options={"canHandleVariableCommunicationStepSize": True,
+                 "canGetAndSetFMUstate": True, "canSerializeFMUstate": True},
+        equations_html=ROTOR_EQUATIONS,
+    ),
+)
+
+
+# ---------------------------------------------------------------------------- metadata
+def load_variable_meta(script: Path) -> dict[str, tuple[str, float | None, float | None]]:
+    """Read VARIABLE_META from the FMU script without registering it in sys.modules."""
+    spec = importlib.util.spec_from_file_location(f"_meta_{script.stem}", script)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.path.insert(0, str(script.parent))
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(script.parent))
+    return dict(module.VARIABLE_META)
+
+
+def _fmt(value: float) -> str:
+    return repr(float(value))
+
+
+# ---------------------------------------------------------------------------- XML
+def add_units_and_ranges(root: ET.Element, meta: dict) -> None:
+    """Put unit/min/max on the type elements and write <UnitDefinitions>."""
+    used: list[str] = []
+    for sv in root.iter("ScalarVariable"):
+        name = sv.get("name", "")
+        type_el = sv[0]
+        if name not in meta:
+            if type_el.tag == "Real":
+                raise SystemExit(f"build: Real variable '{name}' has no entry in VARIABLE_META")
+            continue
+        unit, lo, hi = meta[name]
+        if type_el.tag == "Real" and unit:
+            if unit not in BASE_UNITS:
+                raise SystemExit(f"build: unit '{unit}' of '{name}' not in BASE_UNITS")
+            type_el.set("unit", unit)
+            if unit not in used:
+                used.append(unit)
+        if type_el.tag in ("Real", "Integer"):
+            conv: Callable[[float], str] = _fmt if type_el.tag == "Real" else str
+            if lo is not None:
+                type_el.set("min", conv(lo))
+            if hi is not None:
+                type_el.set("max", conv(hi))
+    _insert_unit_definitions(root, used)
+
+
+def _insert_unit_definitions(root: ET.Element, units: list[str]) -> None:
+    old = root.find("UnitDefinitions")
+    if old is not None:
+        root.remove(old)
+    if not units:
+        return
+    defs = ET.Element("UnitDefinitions")
+    for unit in units:
+        u = ET.SubElement(defs, "Unit", name=unit)
+        ET.SubElement(u, "BaseUnit", {k: str(v) for k, v in BASE_UNITS[unit].items()})
+    # schema order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
+    index = list(root).index(root.find("CoSimulation")) + 1
+    root.insert(index, defs)
+
+
+def fix_model_structure(root: ET.Element) -> None:
+    """<Outputs> lists every output; <InitialUnknowns> lists outputs whose initial is
+    approx/calculated and calculated parameters (FMI 2.0 section 2.2.8). Outputs are computed
+    in doStep only (no direct feedthrough from inputs), hence dependencies=""."""
+    variables = list(root.find("ModelVariables"))
+    old = root.find("ModelStructure")
+    if old is not None:
+        root.remove(old)
+    structure = ET.SubElement(root, "ModelStructure")
+    outputs = ET.SubElement(structure, "Outputs")
+    initial_unknowns: list[int] = []
+    for index, sv in enumerate(variables, start=1):
+        causality = sv.get("causality", "local")
+        if causality == "output":
+            ET.SubElement(outputs, "Unknown", index=str(index), dependencies="")
+            if sv.get("initial", "calculated") in ("approx", "calculated"):
+                initial_unknowns.append(index)
+        elif causality == "calculatedParameter":
+            initial_unknowns.append(index)
+    if not len(outputs):
+        structure.remove(outputs)
+    if initial_unknowns:
+        unknowns = ET.SubElement(structure, "InitialUnknowns")
+        for index in initial_unknowns:
+            ET.SubElement(unknowns, "Unknown", index=str(index))
+
+
+def set_capabilities(root: ET.Element, options: dict[str, bool]) -> None:
+    cs = root.find("CoSimulation")
+    for key, value in options.items():
+        cs.set(key, "true" if value else "false")
+
+
+def postprocess_xml(xml_bytes: bytes, spec: FmuSpec, meta: dict) -> bytes:
+    root = ET.fromstring(xml_bytes)
+    add_units_and_ranges(root, meta)
+    fix_model_structure(root)
+    set_capabilities(root, spec.options)
+    pretty = parseString(ET.tostring(root, encoding="utf-8")).toprettyxml(
+        indent="  ", encoding="UTF-8")
+    return b"\n".join(line for line in pretty.splitlines() if line.strip()) + b"\n"
+
+
+# ---------------------------------------------------------------------------- docs
+def variable_rows(xml_bytes: bytes) -> list[dict[str, str]]:
+    """One dict per variable (name, type, causality, variability, start, unit, min, max,
+    description), read from a modelDescription.xml."""
+    root = ET.fromstring(xml_bytes)
+    rows = []
+    for sv in root.iter("ScalarVariable"):
+        t = sv[0]
+        rows.append({
+            "name": sv.get("name", ""), "type": t.tag,
+            "causality": sv.get("causality", "local"),
+            "variability": sv.get("variability", "continuous"),
+            "start": t.get("start", ""), "unit": t.get("unit", ""),
+            "min": t.get("min", ""), "max": t.get("max", ""),
+            "description": sv.get("description", ""),
+        })
+    return rows
+
+
+def documentation_html(xml_bytes: bytes, spec: FmuSpec) -> str:
+    root = ET.fromstring(xml_bytes)
+    cols = ["name", "type", "causality", "variability", "start", "unit", "min", "max",
+            "description"]
+    head = "".join(f"<th>{c}</th>" for c in cols)
+    body = "\n".join(
+        "<tr>" + "".join(f"<td>{html.escape(r[c])}</td>" for c in cols) + "</tr>"
+        for r in variable_rows(xml_bytes))
+    title = html.escape(spec.name)
+    desc = html.escape(root.get("description", ""))
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{title}</title>
+<style>body{{font-family:sans-serif;max-width:70em}}table{{border-collapse:collapse}}
+td,th{{border:1px solid #999;padding:2px 6px;font-size:90%}}pre{{background:#f4f4f4}}</style>
+</head><body>
+<h1>{title}</h1>
+<p>{desc}</p>
+<p>FMI 2.0 co-simulation, generated by {html.escape(root.get("generationTool", ""))}.
+Needs a Python 3 host process (FMPy, libcosimpy, ecospy) or LD_PRELOAD of libpython in
+native hosts.</p>
+<h2>Variables</h2>
+<table><tr>{head}</tr>
+{body}
+</table>
+{spec.equations_html}
+</body></html>
+"""
+
+
+# ---------------------------------------------------------------------------- build
+def _pythonfmu_build(spec: FmuSpec, out_dir: Path) -> Path:
+    from pythonfmu import FmuBuilder
+
+    flags = {k: v for k, v in spec.options.items()}
+    return Path(FmuBuilder.build_FMU(
+        ROOT / spec.script, dest=out_dir,
+        project_files=[ROOT / d for d in spec.project_dirs], **flags))
+
+
+def _rewrite_zip(src: Path, dst: Path, spec: FmuSpec, meta: dict) -> None:
+    with zipfile.ZipFile(src) as zin:
+        xml_bytes = postprocess_xml(zin.read("modelDescription.xml"), spec, meta)
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zout:
+            for item in zin.infolist():
+                name = item.filename
+                if name == "modelDescription.xml" or name.startswith("documentation/"):
+                    continue
+                if "__pycache__" in name or name.endswith(".pyc"):
+                    continue
+                zout.writestr(item, zin.read(name))
+            zout.writestr("modelDescription.xml", xml_bytes)
+            zout.writestr("documentation/index.html", documentation_html(xml_bytes, spec))
+    dst.write_bytes(buf.getvalue())
+
+
+def build_fmu(spec: FmuSpec, dest_dir: Path) -> Path:
+    """Build, post-process and return the path of <dest_dir>/<name>.fmu (not validated)."""
+    dest_dir.mkdir(parents=True, exist_ok=True)
+    meta = load_variable_meta(ROOT / spec.script)
+    with tempfile.TemporaryDirectory(prefix="rotortd_build_") as tmp:
+        raw = _pythonfmu_build(spec, Path(tmp))
+        final = dest_dir / f"{spec.name}.fmu"
+        staged = Path(tmp) / "staged.fmu"
+        _rewrite_zip(raw, staged, spec, meta)
+        shutil.move(str(staged), final)       # atomic enough: never a half-written FMU
+    return final
+
+
+def validate(fmu: Path) -> list[str]:
+    """Problems found by fmpy.validation and `fmutool -check` (empty list = clean)."""
+    from fmpy.validation import validate_fmu
+
+    problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
+    problems += [f"fmutool: {p}" for p in _fmutool_check(fmu)]
+    return problems
+
+
+def _fmutool_check(fmu: Path) -> list[str]:
+    exe = shutil.which("fmutool")
+    cmd = [exe] if exe else [sys.executable, "-m", "fmu_manipulation_toolbox.cli.fmutool"]
+    proc = subprocess.run([*cmd, "-input", str(fmu), "-check"], capture_output=True,
+                          text=True, timeout=300)
+    out = proc.stdout + proc.stderr
+    print(out.rstrip())
+    problems = [line for line in out.splitlines()
+                if line.split("|")[0].strip() in ("WARNING", "ERROR", "CRITICAL")]
+    for expected in ("seems to be compliant with FMI-2.0", "No semantic error"):
+        if expected not in out:
+            problems.append(f"fmutool output lacks '{expected}'")
+    if proc.returncode != 0:
+        problems.append(f"fmutool exited with {proc.returncode}")
+    return problems
+
+
+def build_all(dest_dir: Path, names: list[str] | None = None, check: bool = True) -> list[Path]:
+    built = []
+    for spec in FMU_SPECS:
+        if names and spec.name not in names:
+            continue
+        fmu = build_fmu(spec, dest_dir)
+        print(f"build: wrote {fmu}")
+        if check:
+            problems = validate(fmu)
+            if problems:
+                print(f"build: {fmu.name}: {len(problems)} problem(s):")
+                for p in problems:
+                    print(f"  - {p}")
+                raise SystemExit(1)
+            print(f"build: {fmu.name}: fmpy validate and fmutool -check: no problems")
+        built.append(fmu)
+    return built
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dest", type=Path, default=ROOT / "models",
+                        help="output directory (default: models/)")
+    parser.add_argument("--only", nargs="*", help="names of FMUs to build (default: all)")
+    parser.add_argument("--no-check", action="store_true", help="skip validation")
+    args = parser.parse_args(argv)
+    build_all(args.dest, args.only, check=not args.no_check)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
