@@ -1,0 +1,2 @@
+"""Offline tools for the RotorTouchdown FMU (plots). Uses numpy/matplotlib; never imported by
+the FMU itself."""
