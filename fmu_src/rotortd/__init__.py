@@ -1,0 +1,44 @@
+"""rotortd: exact event-driven simulator of a rotor in its touchdown bearing.
+
+Pure Python on ``math``/``cmath`` (no numpy, no pythonfmu), so it is fast for scalar
+work and safe inside any FMI host. SI units and the inertial frame unless stated.
+The FMU (``fmu_src/RotorTouchdown.py``) is a thin adapter over ``TouchdownCore``.
+"""
+
+from .contact import RubEquilibrium, WallForces, forward_rub_equilibria
+from .impact import Impact
+from .params import TUNABLE, InputError, ParameterError, RotorParams, ScaledParams
+from .simulator import (
+    MODE_FREE,
+    MODE_ROLLING,
+    MODE_SLIDING,
+    STATUS_ACCUMULATION,
+    STATUS_OK,
+    STATUS_WORK_CAP,
+    Kinematics,
+    StepReport,
+    TouchdownCore,
+    work_cap,
+)
+
+__all__ = [
+    "MODE_FREE",
+    "MODE_ROLLING",
+    "MODE_SLIDING",
+    "STATUS_ACCUMULATION",
+    "STATUS_OK",
+    "STATUS_WORK_CAP",
+    "TUNABLE",
+    "Impact",
+    "InputError",
+    "Kinematics",
+    "ParameterError",
+    "RotorParams",
+    "RubEquilibrium",
+    "ScaledParams",
+    "StepReport",
+    "TouchdownCore",
+    "WallForces",
+    "forward_rub_equilibria",
+    "work_cap",
+]

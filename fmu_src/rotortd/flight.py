@@ -1,0 +1,189 @@
+"""Exact free flight of the rotor centre between events (MODEL.md eq. (1)).
+
+Frame and units: inertial, SI. ``z`` (m) and ``v = z'`` (m/s) are complex. Over one
+segment the inputs ``Omega`` (rad/s), ``F_ext`` (N) and the bearing state ``a`` are held,
+so per unit mass
+
+    z'' = -beta z' - kappa z + f0 + F1 e^{i psi(t)},   psi(t) = psi0 + Omega t,
+
+with beta = a c/m (1/s), kappa = a k/m (1/s^2), f0 = (a F_bias - i m g + F_ext)/m (m/s^2)
+and F1 = e_c Omega^2 e^{i phi} (m/s^2). With A = [[0, 1], [-kappa, -beta]] (real) and
+eigenvalues l1, l2, Duhamel's formula gives for a flight of length s
+
+    [z; v](s) = exp(A s) [z0; v0] + int_0^s exp(A r) dr [0; f0]
+                + e^{i psi0} e^{i Omega s} int_0^s exp((A - i Omega) r) dr [0; F1].
+
+All three matrix functions are written with divided differences of exp on the nodes
+{l1 s, l2 s}, {0, l1 s, l2 s} and {0, (l1 - i Omega) s, (l2 - i Omega) s} (divdiff.py),
+which are entire in the nodes: one code path covers k = 0, c = 0, critical damping,
+(near-)resonance and Omega = 0 without dividing by anything that can vanish.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import dataclass
+
+from .divdiff import dd2, dd3
+from .params import RotorParams
+
+
+@dataclass(frozen=True)
+class FlightCoeffs:
+    """Coefficients of the flight map over a fixed length ``s`` (s), inertial frame, SI.
+
+    z(s) = p11 z0 + p12 v0 + f0 qz0 + F1 E0 qzs,   v(s) = p21 z0 + p22 v0 + f0 qv0 + F1 E0 qvs,
+    E0 = e^{i psi0}; ``rot`` = e^{i Omega s}.
+    """
+
+    s: float
+    p11: float
+    p12: float
+    p21: float
+    p22: float
+    qz0: complex
+    qv0: complex
+    qzs: complex
+    qvs: complex
+    rot: complex
+
+
+class FlightModel:
+    """Free flight under held inputs (inertial frame, SI); see the module docstring.
+
+    Besides propagation it provides the bounds the event locator needs: with |z| <= c_r,
+    |z''| <= beta |v| + K and |z'''| <= beta |z''| + kappa |v| + J, where
+    K = kappa c_r + |f0| + |F1| (m/s^2) and J = |Omega| |F1| (m/s^3).
+    """
+
+    _CACHE_SIZE = 8
+
+    def __init__(self, params: RotorParams, Omega: float, F_ext: complex, amb: float) -> None:
+        p = params
+        self.params = p
+        self.Omega = float(Omega)
+        self.F_ext = complex(F_ext)
+        self.amb = float(amb)
+        self.beta = amb * p.c / p.m
+        self.kappa = amb * p.k / p.m
+        self.f0 = (amb * p.bias_force + p.gravity_force + self.F_ext) / p.m
+        self.F1 = p.e_c * self.Omega * self.Omega * cmath.exp(1j * p.phi)
+        self.c_r = p.c_r
+        self.l1, self.l2 = _eigenvalues(self.beta, self.kappa)
+        self.K = self.kappa * p.c_r + abs(self.f0) + abs(self.F1)
+        self.J = abs(self.Omega) * abs(self.F1)
+        self._cache: dict[float, FlightCoeffs] = {}
+
+    # -- propagation --------------------------------------------------------------------
+
+    def coeffs(self, s: float, cache: bool = False) -> FlightCoeffs:
+        """Flight-map coefficients for length ``s`` >= 0 (s); cached when ``cache``."""
+        hit = self._cache.get(s)
+        if hit is not None:
+            return hit
+        co = self._compute_coeffs(s)
+        if cache:
+            if len(self._cache) >= self._CACHE_SIZE:
+                self._cache.clear()
+            self._cache[s] = co
+        return co
+
+    def _compute_coeffs(self, s: float) -> FlightCoeffs:
+        la, lb = self.l1, self.l2
+        W = self.Omega
+        ea = cmath.exp(la * s)
+        d2 = s * dd2(la * s, lb * s)
+        d30 = s * s * dd3(0j, la * s, lb * s)
+        iw = 1j * W
+        d3s = s * s * dd3(0j, (la - iw) * s, (lb - iw) * s)
+        rot = cmath.exp(iw * s)
+        return FlightCoeffs(
+            s=s,
+            p11=(ea - la * d2).real,
+            p12=d2.real,
+            p21=(-self.kappa * d2).real,
+            p22=(ea + lb * d2).real,
+            qz0=d30.real + 0j,
+            qv0=d2.real + 0j,
+            qzs=rot * d3s,
+            qvs=d2.real + iw * rot * d3s,
+            rot=rot,
+        )
+
+    def propagate(
+        self, z0: complex, v0: complex, E0: complex, s: float, cache: bool = False
+    ) -> tuple[complex, complex]:
+        """State (z, v) after a flight of ``s`` seconds from (z0, v0) with e^{i psi0} = E0."""
+        if s == 0.0:
+            return z0, v0
+        co = self.coeffs(s, cache)
+        g = self.F1 * E0
+        z = co.p11 * z0 + co.p12 * v0 + self.f0 * co.qz0 + g * co.qzs
+        v = co.p21 * z0 + co.p22 * v0 + self.f0 * co.qv0 + g * co.qvs
+        return z, v
+
+    def accel(self, z: complex, v: complex, E: complex) -> complex:
+        """Free-flight acceleration z'' (m/s^2) at state (z, v) and phasor E = e^{i psi}."""
+        return -self.beta * v - self.kappa * z + self.f0 + self.F1 * E
+
+    def jerk(self, v: complex, acc: complex, E: complex) -> complex:
+        """Free-flight jerk z''' (m/s^3) from v, z'' and E = e^{i psi}."""
+        return -self.beta * acc - self.kappa * v + 1j * self.Omega * self.F1 * E
+
+    # -- global exclusion -----------------------------------------------------------------
+
+    def sup_radius_bound(self, z0: complex, v0: complex, E0: complex) -> float:
+        """Upper bound (m) of sup_{t >= 0} |z(t)| of the unconstrained flight, or inf.
+
+        z = Z0 + Z1 e^{i psi(t)} + z_h(t): the steady response to the constant and the
+        rotating force plus a homogeneous transient. |Z0 + Z1 e^{i psi}| <= |Z0| + |Z1|;
+        the transient is bounded by the decaying quadratic form of the damped oscillator
+        (underdamped) or by e^{l1 t}(|zeta0| + |eta0 - mu zeta0| t) (any damping).
+        Returns inf where no finite bound exists (kappa = 0, undamped resonance).
+        """
+        kap, beta, W = self.kappa, self.beta, self.Omega
+        if kap <= 0.0:
+            return math.inf
+        den = complex(kap - W * W, beta * W)
+        if den == 0:
+            return math.inf
+        Z0 = self.f0 / kap
+        Z1 = self.F1 * E0 / den
+        zeta = z0 - Z0 - Z1
+        eta = v0 - 1j * W * Z1
+        return abs(Z0) + abs(Z1) + _transient_bound(beta, kap, zeta, eta)
+
+
+def _eigenvalues(beta: float, kappa: float) -> tuple[complex, complex]:
+    """Eigenvalues (1/s) of [[0, 1], [-kappa, -beta]], the more negative one first.
+
+    The discriminant beta^2/4 - kappa is formed as a product to avoid cancellation
+    near critical damping.
+    """
+    hb = 0.5 * beta
+    rk = math.sqrt(kappa)
+    disc = (hb - rk) * (hb + rk)
+    if disc >= 0.0:
+        r = math.sqrt(disc)
+        return complex(-hb - r), complex(-hb + r)
+    r = math.sqrt(-disc)
+    return complex(-hb, -r), complex(-hb, r)
+
+
+def _transient_bound(beta: float, kappa: float, zeta: complex, eta: complex) -> float:
+    """sup_{t>=0} |z_h(t)| (m) for z_h'' + beta z_h' + kappa z_h = 0, z_h(0)=zeta, z_h'(0)=eta."""
+    hb = 0.5 * beta
+    rk = math.sqrt(kappa)
+    disc = (hb - rk) * (hb + rk)
+    best = math.inf
+    if disc < 0.0:
+        nu = math.sqrt(-disc)
+        best = math.sqrt(nu * nu * abs(zeta) ** 2 + abs(eta + hb * zeta) ** 2) / nu
+    alpha = kappa / (hb + math.sqrt(max(disc, 0.0))) if disc >= 0.0 else hb  # -Re l1
+    if alpha > 0.0:
+        A = abs(zeta)
+        B = abs(eta + hb * zeta)
+        sup = A if B <= alpha * A else (B / alpha) * math.exp(alpha * A / B - 1.0)
+        best = min(best, sup)
+    return best

@@ -1,0 +1,75 @@
+"""Gragg–Bulirsch–Stoer extrapolation for small smooth ODE systems, pure Python.
+
+Used for the sliding phase (contact.py), where a tolerance of 1e-13 relative is wanted:
+extrapolation of the modified midpoint rule reaches order 2k with k columns, so steps stay
+long at tight tolerances, and it shares no coefficients with the validation integrators
+(scipy's DOP853 and mpmath's Taylor method).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+Vector = list[float]
+Rhs = Callable[[float, Sequence[float]], Vector]
+
+SEQUENCE = (2, 4, 6, 8, 10, 12, 14, 16, 18)
+"""Substep counts of the modified midpoint rule (the 'double harmonic' sequence)."""
+
+
+def midpoint(rhs: Rhs, u0: float, y0: Sequence[float], f0: Sequence[float], H: float, n: int) -> Vector:
+    """Gragg's modified midpoint rule over [u0, u0 + H] with n substeps, smoothed at the end."""
+    h = H / n
+    ym = list(y0)
+    yc = [a + h * b for a, b in zip(y0, f0)]
+    for i in range(1, n):
+        f = rhs(u0 + i * h, yc)
+        ym, yc = yc, [a + 2.0 * h * b for a, b in zip(ym, f)]
+    f = rhs(u0 + H, yc)
+    return [0.5 * (a + b + h * c) for a, b, c in zip(yc, ym, f)]
+
+
+def extrapolated_step(
+    rhs: Rhs,
+    u0: float,
+    y0: Sequence[float],
+    f0: Sequence[float],
+    H: float,
+    scale: Sequence[float],
+    k_min: int = 3,
+    k_max: int = len(SEQUENCE),
+    k_fixed: int | None = None,
+) -> tuple[Vector, float, int, int]:
+    """One extrapolated step of length H.
+
+    ``scale[i]`` is the tolerance for component i (components beyond len(scale) are not
+    error-controlled). Returns (y, err, k, nfev): err <= 1 means accepted at column k;
+    with ``k_fixed`` exactly that many columns are used (for event re-integration).
+    """
+    table: list[Vector] = []
+    err = float("inf")
+    nfev = 0
+    k_stop = k_fixed if k_fixed is not None else k_max
+    for j in range(k_stop):
+        n = SEQUENCE[j]
+        row_new = midpoint(rhs, u0, y0, f0, H, n)
+        nfev += n
+        extr = [row_new]
+        for col in range(1, j + 1):
+            r = (n / SEQUENCE[j - col]) ** 2 - 1.0
+            a, b = extr[col - 1], table[col - 1]
+            extr.append([x + (x - w) / r for x, w in zip(a, b)])
+        if j >= 1:
+            err = max(abs(extr[j][i] - extr[j - 1][i]) / scale[i] for i in range(len(scale)))
+            if k_fixed is None and j + 1 >= k_min and err <= 1.0:
+                return extr[j], err, j + 1, nfev
+        table = extr
+    return table[-1], err, k_stop, nfev
+
+
+def next_step_size(H: float, err: float, k: int) -> float:
+    """Step-size proposal after a step with error ratio ``err`` at column ``k`` (order 2k)."""
+    if err == 0.0:
+        return 4.0 * H
+    fac = 0.9 * (0.5 / err) ** (1.0 / (2 * k - 1))
+    return H * min(4.0, max(0.2, fac))

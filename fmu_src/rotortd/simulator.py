@@ -1,0 +1,640 @@
+"""The event-driven simulator: exact flight, located impacts, sustained contact.
+
+Frame and units: inertial, SI, unless a name says otherwise. ``TouchdownCore.step``
+advances the rotor by one communication step with inputs held (Omega, F_ext, a) and
+returns a ``StepReport``. The story it resolves:
+
+    free flight -> impacts -> chattering -> sliding <-> rolling -> lift-off -> free flight
+
+Low-speed rule (when an impact becomes sustained contact). At an impact with normal speed
+v, let A > 0 be the outward normal acceleration the contact-free forces give at the wall
+(the rotor would come back), v_b = d v the rebound speed, h_b = v_b^2/(2A) the rebound
+height and tau_b = 2 v_b/A its flight time. The impact is made plastic and sustained
+contact begins when
+
+  (1) h_b <= ETA_HEIGHT c_r (the remaining chattering cascade is below resolution), or
+  (2) the cascade to (1) would need more than N_CASCADE further impacts (d close to 1,
+      or d = 1 where it never ends) and the bounce is short, tau_b <= ETA_TIME/w_ref,
+      w_ref = max(|Omega|, |theta'|, R|Omega|/c_r, sqrt(kappa), beta, sqrt(A/c_r)).
+
+Rule (1) replaces a cascade with total normal momentum m(1+d)v/(1-d) by a plastic impact
+m v plus sliding, which delivers the rest in the accumulation time 2 d v/((1-d) A): the
+same momentum and friction impulse, so the state after the accumulation point is off by
+O(h_b) in position and O(v_b^2/((1-d)A c_r)) in phase. Rule (2) replaces bounces of height
+at most ETA_TIME^2 c_r/8 by sliding; the bounce energy 1/2 m v_b^2 (which d < 1 would
+dissipate later, d = 1 never) is dissipated at once. Neither threshold depends on the
+communication step.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import dataclass, field
+
+from .contact import (
+    ContactTally,
+    ContactWorkExceeded,
+    Rolling,
+    Sliding,
+    WallForces,
+    forward_rub_equilibria,
+    wrap_angle,
+)
+from .events import ContactLocator, SearchExhausted, Work
+from .flight import FlightModel
+from .impact import Impact, reset
+from .params import InputError, ParameterError, RotorParams, check_finite, check_range
+
+MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
+STATUS_OK, STATUS_WORK_CAP, STATUS_ACCUMULATION = 0, 1, 2
+STATE_SCHEMA, STATE_VERSION = "rotortd-state", 1
+
+ETA_HEIGHT = 1e-14
+"""Rule (1): rebound height below ETA_HEIGHT c_r counts as contact."""
+ETA_TIME = 1e-3
+"""Rule (2): rebound flight time below ETA_TIME / w_ref counts as contact (long cascades)."""
+N_CASCADE = 1000
+"""Rule (2) applies when more than N_CASCADE impacts would remain before rule (1)."""
+LOCK_TOL = 1e-13
+"""Sliding state within LOCK_TOL (rad, and relative in rate) of a stable forward-rub
+equilibrium is advanced as a rigid rotation."""
+WORK_BASE = 20_000
+WORK_PER_RADIAN = 20_000
+"""Work cap of one step: WORK_BASE + WORK_PER_RADIAN * h * w_max (see work_cap)."""
+_R_CLEAR = 1.0 - 1e-9
+_TWO_PI_HI, _TWO_PI_LO = 6.283185307179586, 2.4492935982947064e-16
+
+
+class WorkCapExceeded(RuntimeError):
+    """A step exceeded its work cap."""
+
+
+@dataclass
+class StepReport:
+    """What happened in one step (SI, inertial). Forces are step averages (impulse/h)."""
+
+    status: int = STATUS_OK
+    message: str = ""
+    impacts: list[Impact] = field(default_factory=list)
+    F_contact: complex = 0j
+    F_n: float = 0.0
+    F_n_peak: float = 0.0
+    P_n: float = 0.0
+    T_f: float = 0.0
+    E_diss: float = 0.0
+    mode: int = MODE_FREE
+    work: int = 0
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Outputs derived from the state (SI; u_*, du_* scaled co-rotating, t = Omega tau).
+
+    x, y (m), vx, vy (m/s), r_rel = |z|/c_r, u = z e^{-i psi}/c_r, du = dU/dt (0 when
+    Omega = 0), psi_wrapped (rad, (-pi, pi]), whirl_rate theta' (rad/s, inertial),
+    v_rel = R Omega + c_r theta' (m/s), F_amb = a (F_bias - c v - k z) (N).
+    """
+
+    x: float
+    y: float
+    vx: float
+    vy: float
+    r_rel: float
+    u_re: float
+    u_im: float
+    du_re: float
+    du_im: float
+    psi_wrapped: float
+    whirl_rate: float
+    v_rel: float
+    F_amb_x: float
+    F_amb_y: float
+
+
+class _Tally:
+    """Impulses and contact integrals accumulated over one step (SI)."""
+
+    def __init__(self) -> None:
+        self.impacts: list[Impact] = []
+        self.P_vec = 0j  # N s, on the rotor
+        self.P_n = 0.0  # N s
+        self.P_t = 0.0  # N s, signed friction impulse (torque impulse = -R P_t)
+        self.E = 0.0  # J
+        self.peak = 0.0  # N
+
+    def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
+        self.P_vec += mc * tal.I_c
+        self.P_n += mc * tal.I_n
+        self.P_t += mc * tal.I_t
+        self.E += mc * c_r * tal.I_e
+        self.peak = max(self.peak, mc * tal.peak)
+
+
+def work_cap(p: RotorParams, h: float, Omega: float, F_ext: complex, amb: float) -> int:
+    """Documented cap on the work counter of one step of length h (s).
+
+    WORK_BASE + WORK_PER_RADIAN * h * w_max, where w_max (rad/s) is the largest rate in
+    the scene: |Omega|, R|Omega|/c_r (rolling whirl), sqrt(k/m), c/m, and the rate
+    sqrt(F/(m c_r)) at which the largest force moves the rotor across the clearance.
+    """
+    force = abs(F_ext) + p.m * p.g + amb * p.m * p.g * p.levitate + p.m * p.e_c * Omega**2
+    w_max = max(
+        abs(Omega),
+        p.R * abs(Omega) / p.c_r,
+        math.sqrt(amb * p.k / p.m),
+        amb * p.c / p.m,
+        math.sqrt(force / (p.m * p.c_r)),
+    )
+    return int(WORK_BASE + WORK_PER_RADIAN * min(h * w_max, 1e12))
+
+
+class TouchdownCore:
+    """Rotor in a touchdown bearing, advanced step by step (see the module docstring)."""
+
+    def __init__(
+        self, params: RotorParams, z0: complex = 0j, v0: complex = 0j, psi0: float = 0.0,
+        t0: float = 0.0,
+    ) -> None:
+        z0, v0 = complex(z0), complex(v0)
+        for name, val in (("x0", z0.real), ("y0", z0.imag), ("vx0", v0.real),
+                          ("vy0", v0.imag), ("psi0", psi0), ("t0", t0)):
+            check_finite(name, val)
+        if abs(z0) > params.c_r * (1.0 + 1e-12):
+            raise ParameterError(
+                f"initial position |z0| = {abs(z0)!r} m is outside the clearance: "
+                f"it must satisfy sqrt(x0^2 + y0^2) <= c_r = {params.c_r!r} m"
+            )
+        self._p = params
+        self._t = float(t0)
+        self._z, self._v = z0, v0
+        self._psi, self._turns = wrap_angle(float(psi0)), 0
+        self._turns = round((float(psi0) - self._psi) / _TWO_PI_HI)
+        self._mode = MODE_FREE
+        self._theta = 0.0
+        self._dtheta = 0.0
+        self._slip = 0.0
+        self._locked = False
+        self._on_wall = abs(z0) >= params.c_r * (1.0 - 1e-15)
+        self._clear = False
+        self._n_impacts = 0
+        self._t_last = 0.0
+        self._v_last = 0.0
+        self._E_diss = 0.0
+        self._t_contact = math.nan
+        self._H = math.inf
+        self._inputs: tuple[float, complex, float] = (0.0, 0j, 1.0)
+        self._fm: FlightModel | None = None
+        self._wf: WallForces | None = None
+
+    # ------------------------------------------------------------------ constructors
+
+    @classmethod
+    def from_scaled(
+        cls, params: RotorParams, Omega: float, U0: complex = 0j, dU0: complex = 0j,
+        psi0: float = 0.0, t0: float = 0.0,
+    ) -> TouchdownCore:
+        """Start from the co-rotating scaled state: z = c_r U e^{i psi}, dU/dt with t = Omega tau."""
+        W = check_finite("Omega", Omega)
+        if W == 0.0:
+            raise ParameterError("Omega = 0.0 rad/s: a scaled initial state needs Omega != 0")
+        rot = cmath.exp(1j * psi0)
+        z0 = params.c_r * complex(U0) * rot
+        v0 = params.c_r * (W * complex(dU0) + 1j * W * complex(U0)) * rot
+        return cls(params, z0, v0, psi0, t0)
+
+    @classmethod
+    def on_steady_whirl(
+        cls, params: RotorParams, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0,
+        psi0: float = 0.0, t0: float = 0.0,
+    ) -> TouchdownCore:
+        """Start on the steady free whirl z = Z0 + Z1 e^{i psi} (the regular equilibrium U*).
+
+        Raises ParameterError when it does not exist (no stiffness, undamped resonance) or
+        is not admissible (it leaves the clearance).
+        """
+        fm = FlightModel(params, check_finite("Omega", Omega), complex(F_ext),
+                         check_range("amb_on", amb_on, 0.0, 1.0))
+        den = complex(fm.kappa - fm.Omega**2, fm.beta * fm.Omega)
+        if fm.kappa <= 0.0 or den == 0:
+            raise ParameterError(
+                "start_steady: no steady whirl exists without stiffness (k*amb_on > 0) "
+                "or at undamped resonance (c = 0 and Omega^2 = k/m)"
+            )
+        E0 = cmath.exp(1j * psi0)
+        Z0, Z1 = fm.f0 / fm.kappa, fm.F1 * E0 / den
+        if abs(Z0) + abs(Z1) >= params.c_r:
+            raise ParameterError(
+                f"start_steady: the steady whirl is not admissible, its radius reaches "
+                f"|Z0| + |Z1| = {(abs(Z0) + abs(Z1)) / params.c_r:.6g} c_r; it must be < 1 c_r"
+            )
+        return cls(params, Z0 + Z1, 1j * fm.Omega * Z1, psi0, t0)
+
+    # ------------------------------------------------------------------ state access
+
+    @property
+    def params(self) -> RotorParams:
+        """Current parameters."""
+        return self._p
+
+    def set_params(self, params: RotorParams) -> None:
+        """Change parameters (tunables); takes effect from the next step."""
+        if params.c_r != self._p.c_r:
+            raise ParameterError("c_r is fixed after initialisation; it cannot change mid-run")
+        self._p = params
+        self._fm = None
+        self._wf = None
+        self._clear = False
+        self._locked = False
+
+    @property
+    def t(self) -> float:
+        """Time (s)."""
+        return self._t
+
+    @property
+    def z(self) -> complex:
+        """Position of the rotor centre (m), inertial."""
+        return self._z
+
+    @property
+    def v(self) -> complex:
+        """Velocity of the rotor centre (m/s), inertial."""
+        return self._v
+
+    @property
+    def psi(self) -> float:
+        """Spin angle (rad), unwrapped."""
+        return self._turns * _TWO_PI_HI + (self._psi + self._turns * _TWO_PI_LO)
+
+    @property
+    def mode(self) -> int:
+        """0 free, 1 sliding, 2 rolling."""
+        return self._mode
+
+    @property
+    def n_impacts(self) -> int:
+        """Impacts so far."""
+        return self._n_impacts
+
+    @property
+    def t_last_impact(self) -> float:
+        """Time of the last impact (s); 0 before any."""
+        return self._t_last
+
+    @property
+    def v_last_impact(self) -> float:
+        """Normal speed rdot- of the last impact (m/s); 0 before any."""
+        return self._v_last
+
+    @property
+    def E_diss(self) -> float:
+        """Energy dissipated by contact so far (J)."""
+        return self._E_diss
+
+    @property
+    def t_contact_entry(self) -> float:
+        """Estimated accumulation point (s) of the last chattering that became contact.
+
+        The plastic impact time plus 2 d v/((1-d) A) for rule (1), the impact time
+        otherwise; NaN before any.
+        """
+        return self._t_contact
+
+    def kinematics(self, Omega: float | None = None, amb_on: float | None = None) -> Kinematics:
+        """Derived outputs at the current state, for the given (or last) inputs."""
+        W = self._inputs[0] if Omega is None else float(Omega)
+        a = self._inputs[2] if amb_on is None else float(amb_on)
+        p, z, v = self._p, self._z, self._v
+        rot = cmath.exp(-1j * self._psi)
+        U = z * rot / p.c_r
+        dU = (v - 1j * W * z) * rot / (p.c_r * W) if W != 0.0 else 0j
+        r2 = abs(z) ** 2
+        whirl = (z.conjugate() * v).imag / r2 if r2 > 0.0 else 0.0
+        F_amb = a * (p.bias_force - p.c * v - p.k * z)
+        psi_w = -self._psi if self._psi == -math.pi else self._psi
+        return Kinematics(
+            z.real, z.imag, v.real, v.imag, abs(z) / p.c_r, U.real, U.imag, dU.real,
+            dU.imag, psi_w, whirl, p.R * W + p.c_r * whirl, F_amb.real, F_amb.imag,
+        )
+
+    # ------------------------------------------------------------------ stepping
+
+    def step(self, h: float, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0) -> StepReport:
+        """Advance by h seconds with Omega (rad/s), F_ext (N) and amb_on held."""
+        h = check_range("h", h, 0.0, lo_open=True, error=InputError, unit="s")
+        W = check_finite("Omega", Omega, InputError)
+        F = complex(F_ext)
+        check_finite("F_x", F.real, InputError)
+        check_finite("F_y", F.imag, InputError)
+        a = check_range("amb_on", amb_on, 0.0, 1.0, error=InputError)
+        self._set_inputs(W, F, a)
+        tally = _Tally()
+        work = Work()
+        cap = work_cap(self._p, h, W, F, a)
+        rep = StepReport()
+        t0, s = self._t, 0.0
+        try:
+            while s < h:
+                if work.total > cap:
+                    raise WorkCapExceeded(f"step work exceeded its cap {cap}")
+                s = self._advance(s, h, t0, tally, work)
+        except (WorkCapExceeded, SearchExhausted, ContactWorkExceeded) as exc:
+            rep.status, rep.message = STATUS_WORK_CAP, f"t = {t0 + s!r} s: {exc}"
+        self._t = t0 + h if s >= h else t0 + s
+        self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
+        return rep
+
+    def _set_inputs(self, W: float, F: complex, a: float) -> None:
+        if (W, F, a) != self._inputs or self._fm is None:
+            self._inputs = (W, F, a)
+            self._fm = FlightModel(self._p, W, F, a)
+            self._wf = WallForces.build(self._p, W, F, a)
+            self._clear = False
+            self._locked = False
+
+    def _fill_report(self, rep: StepReport, tal: _Tally, work: Work, h: float) -> None:
+        inv = 1.0 / h if h > 0.0 else 0.0
+        rep.impacts = tal.impacts
+        rep.F_contact = tal.P_vec * inv
+        rep.F_n = tal.P_n * inv
+        rep.P_n = tal.P_n
+        rep.F_n_peak = max(tal.peak, max((i.P_n * inv for i in tal.impacts), default=0.0))
+        rep.T_f = -self._p.R * tal.P_t * inv
+        rep.E_diss = tal.E
+        rep.mode = self._mode
+        rep.work = work.total
+        self._E_diss += tal.E
+
+    def _advance(self, s: float, h: float, t0: float, tally: _Tally, work: Work) -> float:
+        if self._mode == MODE_FREE:
+            return self._advance_free(s, h, t0, tally, work)
+        return self._advance_contact(s, h, tally, work)
+
+    # ------------------------------------------------------------------ free flight
+
+    def _phasor(self) -> complex:
+        return cmath.exp(1j * self._psi)
+
+    def _advance_psi(self, ds: float) -> None:
+        x = self._psi + self._inputs[0] * ds
+        k = math.floor((x + math.pi) / _TWO_PI_HI)
+        if k:
+            x = (x - k * _TWO_PI_HI) - k * _TWO_PI_LO
+            self._turns += k
+        self._psi = x
+
+    def _advance_free(self, s: float, h: float, t0: float, tally: _Tally, work: Work) -> float:
+        fm = self._fm
+        assert fm is not None
+        rem = h - s
+        E = self._phasor()
+        if not self._clear:
+            work.evals += 1
+            self._clear = fm.sup_radius_bound(self._z, self._v, E) < self._p.c_r * _R_CLEAR
+        hit = None
+        if not self._clear:
+            hit = ContactLocator(fm, self._z, self._v, E).find(rem, self._on_wall, work)
+        if hit is None:
+            work.evals += 1
+            self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
+            self._advance_psi(rem)
+            self._on_wall = False
+            return h
+        ds = min(hit.s, rem)
+        self._advance_psi(ds)
+        z = hit.z * (self._p.c_r / abs(hit.z))
+        self._clear = False
+        if hit.kind == "impact":
+            self._impact(t0 + s + ds, z, hit.v, tally)
+        else:
+            self._z, self._v = z, hit.v
+            self._enter_contact(tally, work)
+        return s + ds if ds > 0.0 else s + 0.0
+
+    def _impact(self, t: float, z: complex, v_minus: complex, tally: _Tally) -> None:
+        p = self._p
+        W = self._inputs[0]
+        n = z / p.c_r
+        r = reset(n, v_minus, p.m, p.d, p.mu, p.R, W)
+        plastic = self._low_speed_contact(n, r.rdot, r.v_plus)
+        if plastic:
+            r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)
+        imp = Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t, r.stick, r.E_diss)
+        tally.impacts.append(imp)
+        tally.P_vec -= complex(r.P_n, r.P_t) * n
+        tally.P_n += r.P_n
+        tally.P_t += r.P_t
+        tally.E += r.E_diss
+        self._n_impacts += 1
+        self._t_last, self._v_last = t, r.rdot
+        self._z, self._v = z, r.v_plus
+        self._on_wall = True
+        if plastic:
+            A = self._outward_accel(n, r.v_plus)
+            d = p.d
+            self._t_contact = t + (2.0 * d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)
+            self._enter_contact(tally, Work())
+
+    def _outward_accel(self, n: complex, v: complex) -> float:
+        """A (m/s^2): outward normal acceleration at the wall from contact-free forces."""
+        wf = self._wf
+        assert wf is not None
+        vt = (n.conjugate() * v).imag
+        gn, _ = wf.gn_gt(cmath.phase(n), vt / self._p.c_r, self._phasor())
+        return gn * self._p.c_r
+
+    def _low_speed_contact(self, n: complex, v: float, v_plus: complex) -> bool:
+        """The low-speed rule of the module docstring: does this impact start contact?"""
+        p = self._p
+        A = self._outward_accel(n, v_plus)
+        if A <= 0.0:
+            return False
+        vb = p.d * v
+        if vb * vb <= 2.0 * A * ETA_HEIGHT * p.c_r:
+            return True
+        v1 = math.sqrt(2.0 * A * ETA_HEIGHT * p.c_r)
+        if p.d < 1.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
+            return False
+        wf = self._wf
+        assert wf is not None
+        vt = (n.conjugate() * v_plus).imag
+        w_ref = max(wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
+        return 2.0 * vb / A <= ETA_TIME / w_ref
+
+    # ------------------------------------------------------------------ contact
+
+    def _enter_contact(self, tally: _Tally, work: Work) -> None:
+        """Switch to sustained contact at the current (on-wall) state."""
+        p = self._p
+        z, v = self._z, self._v
+        n = z / abs(z)
+        self._theta = cmath.phase(z)
+        self._dtheta = (n.conjugate() * v).imag / p.c_r
+        self._z = p.c_r * cmath.exp(1j * self._theta)
+        self._mode = MODE_SLIDING
+        self._locked = False
+        self._choose_contact_mode()
+        self._sync_from_contact()
+
+    def _choose_contact_mode(self) -> None:
+        """Pick sliding (with slip sign) or rolling from the current contact state."""
+        wf = self._wf
+        assert wf is not None
+        vrel = wf.wr + self._dtheta
+        if vrel != 0.0:
+            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, vrel)
+            return
+        gn, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
+        if abs(gt) <= wf.mu * gn:
+            self._mode = MODE_ROLLING
+        else:
+            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
+
+    def _sync_from_contact(self) -> None:
+        """Set (z, v) from (theta, theta')."""
+        e = cmath.exp(1j * self._theta)
+        self._z = self._p.c_r * e
+        self._v = 1j * self._p.c_r * self._dtheta * e
+
+    def _advance_contact(self, s: float, h: float, tally: _Tally, work: Work) -> float:
+        wf = self._wf
+        assert wf is not None
+        p = self._p
+        rem = h - s
+        E = self._phasor()
+        if self._mode == MODE_ROLLING and wf.wr + self._dtheta != 0.0:
+            self._choose_contact_mode()  # the spin changed: slip until it rolls again
+        gn, _ = wf.gn_gt(self._theta, self._dtheta, E)
+        if gn <= 0.0:
+            self._lift_off()
+            return s
+        if self._mode == MODE_ROLLING:
+            end = Rolling(wf, self._theta, E).run(rem)
+        elif self._try_lock(E):
+            end = self._locked_rotation(rem, E)
+        else:
+            end, self._H = Sliding(wf, self._theta, self._dtheta, E, self._slip).run(
+                rem, self._H if math.isfinite(self._H) else 0.05 / wf.omega_ref(self._dtheta)
+            )
+        work.iters += end.tally.work
+        tally.add_contact(end.tally, p.m * p.c_r, p.c_r)
+        self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
+        self._advance_psi(end.du)
+        self._transition(end.event)
+        self._sync_from_contact()
+        return s + end.du if end.du < rem else h
+
+    def _transition(self, event: str | None) -> None:
+        wf = self._wf
+        assert wf is not None
+        if event is None:
+            return
+        if event == "lift_off":
+            self._lift_off()
+        elif event == "slip_zero":
+            self._dtheta = -wf.wr
+            self._choose_contact_mode()
+            self._locked = False
+        elif event == "cone":
+            _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
+            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
+
+    def _lift_off(self) -> None:
+        self._sync_from_contact()
+        self._mode = MODE_FREE
+        self._on_wall = True
+        self._locked = False
+        self._clear = False
+
+    def _try_lock(self, E: complex) -> bool:
+        """True when the state sits on a stable forward-rub equilibrium (then lock it)."""
+        if self._locked:
+            return True
+        wf = self._wf
+        assert wf is not None
+        W = wf.Omega
+        if wf.q0 != 0 or abs(self._dtheta - W) > LOCK_TOL * abs(W):
+            return False
+        alpha = wrap_angle(self._theta - cmath.phase(E))
+        for eq in forward_rub_equilibria(wf):
+            if eq.stable and abs(wrap_angle(alpha - eq.alpha)) <= LOCK_TOL:
+                self._theta = wrap_angle(eq.alpha + cmath.phase(E))
+                self._dtheta = W
+                self._locked = True
+                return True
+        return False
+
+    def _locked_rotation(self, rem: float, E: complex):  # noqa: ANN202
+        """Closed-form synchronous rub over rem seconds (theta' = Omega, Gn constant)."""
+        from .contact import SegmentEnd, phase_integral
+
+        wf = self._wf
+        assert wf is not None
+        gn, _ = wf.gn_gt(self._theta, self._dtheta, E)
+        ft = wf.mu * self._slip * gn
+        tal = ContactTally()
+        tal.I_n = gn * rem
+        tal.I_t = ft * rem
+        tal.I_c = -complex(gn, ft) * cmath.exp(1j * self._theta) * phase_integral(wf.Omega, rem)
+        tal.I_e = ft * (wf.wr + self._dtheta) * rem
+        tal.peak = gn
+        tal.work = 1
+        return SegmentEnd(rem, self._theta + wf.Omega * rem, self._dtheta, None, tal)
+
+    # ------------------------------------------------------------------ state (de)serialisation
+
+    def get_state(self) -> dict:
+        """All internal state as a JSON-serialisable dict (floats round-trip exactly)."""
+        p = self._p
+        return {
+            "schema": STATE_SCHEMA,
+            "version": STATE_VERSION,
+            "params": {f: getattr(p, f) for f in p.__dataclass_fields__},
+            "t": self._t,
+            "z": [self._z.real, self._z.imag],
+            "v": [self._v.real, self._v.imag],
+            "psi": self._psi,
+            "turns": self._turns,
+            "mode": self._mode,
+            "theta": self._theta,
+            "dtheta": self._dtheta,
+            "slip": self._slip,
+            "locked": self._locked,
+            "on_wall": self._on_wall,
+            "n_impacts": self._n_impacts,
+            "t_last": self._t_last,
+            "v_last": self._v_last,
+            "E_diss": self._E_diss,
+            "t_contact": None if math.isnan(self._t_contact) else self._t_contact,
+            "H": None if math.isinf(self._H) else self._H,
+            "inputs": [self._inputs[0], self._inputs[1].real, self._inputs[1].imag,
+                       self._inputs[2]],
+        }
+
+    def set_state(self, st: dict) -> None:
+        """Restore a state produced by get_state (same or compatible version)."""
+        if st.get("schema") != STATE_SCHEMA or st.get("version") != STATE_VERSION:
+            raise ParameterError(
+                f"state schema {st.get('schema')!r} version {st.get('version')!r} is not "
+                f"supported: expected {STATE_SCHEMA!r} version {STATE_VERSION}"
+            )
+        self._p = RotorParams(**st["params"])
+        self._t = float(st["t"])
+        self._z = complex(*st["z"])
+        self._v = complex(*st["v"])
+        self._psi, self._turns = float(st["psi"]), int(st["turns"])
+        self._mode = int(st["mode"])
+        self._theta, self._dtheta = float(st["theta"]), float(st["dtheta"])
+        self._slip, self._locked = float(st["slip"]), bool(st["locked"])
+        self._on_wall = bool(st["on_wall"])
+        self._n_impacts = int(st["n_impacts"])
+        self._t_last, self._v_last = float(st["t_last"]), float(st["v_last"])
+        self._E_diss = float(st["E_diss"])
+        self._t_contact = math.nan if st["t_contact"] is None else float(st["t_contact"])
+        self._H = math.inf if st["H"] is None else float(st["H"])
+        W, fx, fy, a = st["inputs"]
+        self._inputs = (float(W), complex(fx, fy), float(a))
+        self._fm = FlightModel(self._p, *self._inputs)
+        self._wf = WallForces.build(self._p, *self._inputs)
+        self._clear = False
