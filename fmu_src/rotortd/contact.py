@@ -319,10 +319,12 @@ class Rolling:
         mu = self.wf.mu
         mk = (self.A1, self.A2, self.nu1, self.nu2)
         gn = TrigSum(self.C, *mk)
-        plus = TrigSum(mu * self.C - self.Gt0, (mu + 1j) * self.A1, (mu + 1j) * self.A2,
-                       self.nu1, self.nu2)
-        minus = TrigSum(mu * self.C + self.Gt0, (mu - 1j) * self.A1, (mu - 1j) * self.A2,
-                        self.nu1, self.nu2)
+        plus = TrigSum(
+            mu * self.C - self.Gt0, (mu + 1j) * self.A1, (mu + 1j) * self.A2, self.nu1, self.nu2
+        )
+        minus = TrigSum(
+            mu * self.C + self.Gt0, (mu - 1j) * self.A1, (mu - 1j) * self.A2, self.nu1, self.nu2
+        )
         return gn, plus, minus
 
     def gn_gt(self, u: float) -> tuple[float, float]:

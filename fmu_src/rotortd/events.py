@@ -94,9 +94,7 @@ def _critical_points(g1: float, g2: float, g3: float, tau: float) -> list[float]
     return sorted(u for u in pts if 0.0 < u < tau)
 
 
-def safe_step(
-    g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
-) -> float | None:
+def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work) -> float | None:
     """Lower bound of the first root in (0, tau] of p(u) = g0 + g1 u + g2 u^2/2 + g3 u^3/6.
 
     Requires g0 <= 0 (g0 == 0 means 'on the wall'; then p(u)/u is examined). Returns
@@ -133,7 +131,7 @@ def _safe_step_on_wall(g1: float, g2: float, g3: float, tau: float, work: Work) 
     return None
 
 
-def _bracket_left(f, lo: float, hi: float, work: Work) -> float:  # noqa: ANN001
+def _bracket_left(f, lo: float, hi: float, work: Work) -> float:
     """Shrink [lo, hi] (f(lo) < 0 <= f(hi), f monotone) by Illinois; return the left end."""
     flo, fhi = f(lo), f(hi)
     side = 0

@@ -184,6 +184,6 @@ def _transient_bound(beta: float, kappa: float, zeta: complex, eta: complex) -> 
     if alpha > 0.0:
         A = abs(zeta)
         B = abs(eta + hb * zeta)
-        sup = A if B <= alpha * A else (B / alpha) * math.exp(alpha * A / B - 1.0)
+        sup = A if alpha * A >= B else (B / alpha) * math.exp(alpha * A / B - 1.0)
         best = min(best, sup)
     return best

@@ -17,7 +17,9 @@ SEQUENCE = (2, 4, 6, 8, 10, 12, 14, 16, 18)
 """Substep counts of the modified midpoint rule (the 'double harmonic' sequence)."""
 
 
-def midpoint(rhs: Rhs, u0: float, y0: Sequence[float], f0: Sequence[float], H: float, n: int) -> Vector:
+def midpoint(
+    rhs: Rhs, u0: float, y0: Sequence[float], f0: Sequence[float], H: float, n: int
+) -> Vector:
     """Gragg's modified midpoint rule over [u0, u0 + H] with n substeps, smoothed at the end."""
     h = H / n
     ym = list(y0)

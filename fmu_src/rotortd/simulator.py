@@ -36,9 +36,11 @@ from .contact import (
     ContactTally,
     ContactWorkExceeded,
     Rolling,
+    SegmentEnd,
     Sliding,
     WallForces,
     forward_rub_equilibria,
+    phase_integral,
     wrap_angle,
 )
 from .events import ContactLocator, SearchExhausted, Work
@@ -153,12 +155,22 @@ class TouchdownCore:
     """Rotor in a touchdown bearing, advanced step by step (see the module docstring)."""
 
     def __init__(
-        self, params: RotorParams, z0: complex = 0j, v0: complex = 0j, psi0: float = 0.0,
+        self,
+        params: RotorParams,
+        z0: complex = 0j,
+        v0: complex = 0j,
+        psi0: float = 0.0,
         t0: float = 0.0,
     ) -> None:
         z0, v0 = complex(z0), complex(v0)
-        for name, val in (("x0", z0.real), ("y0", z0.imag), ("vx0", v0.real),
-                          ("vy0", v0.imag), ("psi0", psi0), ("t0", t0)):
+        for name, val in (
+            ("x0", z0.real),
+            ("y0", z0.imag),
+            ("vx0", v0.real),
+            ("vy0", v0.imag),
+            ("psi0", psi0),
+            ("t0", t0),
+        ):
             check_finite(name, val)
         if abs(z0) > params.c_r * (1.0 + 1e-12):
             raise ParameterError(
@@ -191,10 +203,15 @@ class TouchdownCore:
 
     @classmethod
     def from_scaled(
-        cls, params: RotorParams, Omega: float, U0: complex = 0j, dU0: complex = 0j,
-        psi0: float = 0.0, t0: float = 0.0,
+        cls,
+        params: RotorParams,
+        Omega: float,
+        U0: complex = 0j,
+        dU0: complex = 0j,
+        psi0: float = 0.0,
+        t0: float = 0.0,
     ) -> TouchdownCore:
-        """Start from the co-rotating scaled state: z = c_r U e^{i psi}, dU/dt with t = Omega tau."""
+        """Start from the scaled co-rotating state: z = c_r U e^{i psi}, dU/dt, t = Omega tau."""
         W = check_finite("Omega", Omega)
         if W == 0.0:
             raise ParameterError("Omega = 0.0 rad/s: a scaled initial state needs Omega != 0")
@@ -205,16 +222,25 @@ class TouchdownCore:
 
     @classmethod
     def on_steady_whirl(
-        cls, params: RotorParams, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0,
-        psi0: float = 0.0, t0: float = 0.0,
+        cls,
+        params: RotorParams,
+        Omega: float,
+        F_ext: complex = 0j,
+        amb_on: float = 1.0,
+        psi0: float = 0.0,
+        t0: float = 0.0,
     ) -> TouchdownCore:
         """Start on the steady free whirl z = Z0 + Z1 e^{i psi} (the regular equilibrium U*).
 
         Raises ParameterError when it does not exist (no stiffness, undamped resonance) or
         is not admissible (it leaves the clearance).
         """
-        fm = FlightModel(params, check_finite("Omega", Omega), complex(F_ext),
-                         check_range("amb_on", amb_on, 0.0, 1.0))
+        fm = FlightModel(
+            params,
+            check_finite("Omega", Omega),
+            complex(F_ext),
+            check_range("amb_on", amb_on, 0.0, 1.0),
+        )
         den = complex(fm.kappa - fm.Omega**2, fm.beta * fm.Omega)
         if fm.kappa <= 0.0 or den == 0:
             raise ParameterError(
@@ -314,8 +340,20 @@ class TouchdownCore:
         F_amb = a * (p.bias_force - p.c * v - p.k * z)
         psi_w = -self._psi if self._psi == -math.pi else self._psi
         return Kinematics(
-            z.real, z.imag, v.real, v.imag, abs(z) / p.c_r, U.real, U.imag, dU.real,
-            dU.imag, psi_w, whirl, p.R * W + p.c_r * whirl, F_amb.real, F_amb.imag,
+            z.real,
+            z.imag,
+            v.real,
+            v.imag,
+            abs(z) / p.c_r,
+            U.real,
+            U.imag,
+            dU.real,
+            dU.imag,
+            psi_w,
+            whirl,
+            p.R * W + p.c_r * whirl,
+            F_amb.real,
+            F_amb.imag,
         )
 
     # ------------------------------------------------------------------ stepping
@@ -565,10 +603,8 @@ class TouchdownCore:
                 return True
         return False
 
-    def _locked_rotation(self, rem: float, E: complex):  # noqa: ANN202
+    def _locked_rotation(self, rem: float, E: complex) -> SegmentEnd:
         """Closed-form synchronous rub over rem seconds (theta' = Omega, Gn constant)."""
-        from .contact import SegmentEnd, phase_integral
-
         wf = self._wf
         assert wf is not None
         gn, _ = wf.gn_gt(self._theta, self._dtheta, E)
@@ -608,8 +644,12 @@ class TouchdownCore:
             "E_diss": self._E_diss,
             "t_contact": None if math.isnan(self._t_contact) else self._t_contact,
             "H": None if math.isinf(self._H) else self._H,
-            "inputs": [self._inputs[0], self._inputs[1].real, self._inputs[1].imag,
-                       self._inputs[2]],
+            "inputs": [
+                self._inputs[0],
+                self._inputs[1].real,
+                self._inputs[1].imag,
+                self._inputs[2],
+            ],
         }
 
     def set_state(self, st: dict) -> None:
