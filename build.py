@@ -15,6 +15,7 @@ To add an FMU (e.g. Drivetrain), append an FmuSpec to FMU_SPECS: its script must
 from __future__ import annotations
 
 import argparse
+import hashlib
 import html
 import importlib.util
 import io
@@ -22,6 +23,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import uuid
 import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -202,11 +204,27 @@ def set_capabilities(root: ET.Element, options: dict[str, bool]) -> None:
         cs.set(key, "true" if value else "false")
 
 
-def postprocess_xml(xml_bytes: bytes, spec: FmuSpec, meta: dict) -> bytes:
+def content_guid(root: ET.Element, payload: list[tuple[str, bytes]]) -> str:
+    """A GUID that depends only on the FMU's content (model description without guid and
+    date, plus every other file), so that rebuilding unchanged sources gives the same GUID.
+    PythonFMU's binary never checks the GUID; hosts compare it with the XML."""
+    digest = hashlib.sha256()
+    probe = ET.fromstring(ET.tostring(root))
+    for attr in ("guid", "generationDateAndTime"):
+        probe.attrib.pop(attr, None)
+    digest.update(ET.tostring(probe))
+    for name, data in sorted(payload):
+        digest.update(name.encode() + b"\0" + hashlib.sha256(data).digest())
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, "rotortd:" + digest.hexdigest())) + "}"
+
+
+def postprocess_xml(xml_bytes: bytes, spec: FmuSpec, meta: dict,
+                    payload: list[tuple[str, bytes]]) -> bytes:
     root = ET.fromstring(xml_bytes)
     add_units_and_ranges(root, meta)
     fix_model_structure(root)
     set_capabilities(root, spec.options)
+    root.set("guid", content_guid(root, payload))
     pretty = parseString(ET.tostring(root, encoding="utf-8")).toprettyxml(
         indent="  ", encoding="UTF-8")
     return b"\n".join(line for line in pretty.splitlines() if line.strip()) + b"\n"
@@ -272,19 +290,23 @@ def _pythonfmu_build(spec: FmuSpec, out_dir: Path) -> Path:
 
 def _rewrite_zip(src: Path, dst: Path, spec: FmuSpec, meta: dict) -> None:
     with zipfile.ZipFile(src) as zin:
-        xml_bytes = postprocess_xml(zin.read("modelDescription.xml"), spec, meta)
+        items = [(item, zin.read(item.filename)) for item in zin.infolist()
+                 if _keep_member(item.filename)]
+        payload = [(item.filename, data) for item, data in items]
+        xml_bytes = postprocess_xml(zin.read("modelDescription.xml"), spec, meta, payload)
         buf = io.BytesIO()
         with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zout:
-            for item in zin.infolist():
-                name = item.filename
-                if name == "modelDescription.xml" or name.startswith("documentation/"):
-                    continue
-                if "__pycache__" in name or name.endswith(".pyc"):
-                    continue
-                zout.writestr(item, zin.read(name))
+            for item, data in items:
+                zout.writestr(item, data)
             zout.writestr("modelDescription.xml", xml_bytes)
             zout.writestr("documentation/index.html", documentation_html(xml_bytes, spec))
     dst.write_bytes(buf.getvalue())
+
+
+def _keep_member(name: str) -> bool:
+    if name == "modelDescription.xml" or name.startswith("documentation/"):
+        return False
+    return "__pycache__" not in name and not name.endswith(".pyc")
 
 
 def build_fmu(spec: FmuSpec, dest_dir: Path) -> Path:
