@@ -10,9 +10,12 @@ from __future__ import annotations
 from typing import Any
 
 import mpmath
+import numpy as np
 import pytest
 from mpmath import mp
+from scipy.integrate import solve_ivp
 
+from tests.reference import mp_reference
 from tests.reference.mp_reference import (
     mp_first_impact,
     mp_flight,
@@ -351,6 +354,23 @@ def test_first_impact_consistent_with_flight_and_precision() -> None:
         assert abs(zi) < C_R
 
 
+@pytest.mark.parametrize(
+    "z0,v0,psi0",
+    [(0j, 0j, 0.0), (3e-4 - 1e-4j, 0.02 + 0.05j, 1.3), (-5e-4j, -0.04 + 0.0j, -2.0)],
+)
+def test_first_impact_independent_of_sampling_density(
+    monkeypatch: pytest.MonkeyPatch, z0: complex, v0: complex, psi0: float
+) -> None:
+    """The located impact does not change when the sampling is made 10x denser
+    (a check of the one-extremum-per-interval assumption on typical trajectories)."""
+    p = par(c=0.1 * 50 * OMEGA)
+    coarse = mp_first_impact(p, z0, v0, psi0, OMEGA, 0, 1.0, 0.2)
+    monkeypatch.setattr(mp_reference, "SAMPLES_PER_RAD", 400)
+    fine = mp_first_impact(p, z0, v0, psi0, OMEGA, 0, 1.0, 0.2)
+    assert coarse is not None and fine is not None
+    assert err(coarse[0], fine[0], 1 / OMEGA) < 1e-45
+
+
 def test_start_outside_rejected() -> None:
     with pytest.raises(ValueError):
         mp_first_impact(CHAPTER, 1.01 * C_R, 0, 0, OMEGA, 0, 1.0, 0.1)
@@ -514,3 +534,37 @@ def test_sliding_equals_rolling_limit_consistency() -> None:
     roll = mp_rolling_normal_force(p, 0.1, 0.0, OMEGA, 0, 0.0, 1e-3)
     assert err(out["N_end"], roll["N"], roll["N"]) < 1e-8
     assert err(out["dtheta"], wr * (1 - 1e-9), abs(wr)) < 1e-38
+
+
+def test_sliding_matches_scipy_dop853() -> None:
+    """Generic sliding (chapter set, AMB on, levitated gravity, imbalance, friction)
+    against an independent float64 DOP853 integration at rtol 1e-13."""
+    p = CHAPTER
+    m, c, k, e_c, phi, c_r, mu = (p[key] for key in ("m", "c", "k", "e_c", "phi", "c_r", "mu"))
+    psi0, th0, w0, T = 0.3, 1.0, 150.0, 0.02
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        e = np.exp(1j * y[0])
+        F = (
+            -c * 1j * c_r * y[1] * e
+            - k * c_r * e
+            + m * e_c * OMEGA**2 * np.exp(1j * (psi0 + OMEGA * t + phi))
+        )
+        G = F / e
+        N = G.real + m * c_r * y[1] ** 2
+        return [y[1], (G.imag - mu * N) / (m * c_r)]  # s = +1 (R Ω dominates)
+
+    out = mp_sliding(p, th0, w0, psi0, OMEGA, 0, 1.0, T)
+    sol = solve_ivp(rhs, (0, T), [th0, w0], method="DOP853", rtol=1e-13, atol=[1e-14, 1e-11])
+    assert out["event"] == "t_end"
+    assert abs(float(out["theta"]) - sol.y[0, -1]) < 1e-10
+    assert abs(float(out["dtheta"]) - sol.y[1, -1]) < 1e-10 * OMEGA
+
+
+def test_sliding_precision_converged() -> None:
+    """dps = 40 and dps = 55 agree to ~40 digits on a generic sliding case."""
+    args = (CHAPTER, 0.5, 184.2, 0.3, OMEGA, 10.0 - 5.0j, 1.0, 0.01)
+    lo = mp_sliding(*args, dps=40)
+    hi = mp_sliding(*args, dps=55)
+    assert err(lo["theta"], hi["theta"], 1.0) < 1e-38
+    assert err(lo["dtheta"], hi["dtheta"], OMEGA) < 1e-38

@@ -30,6 +30,11 @@ Methods (all in mpmath, default 50 significant digits plus guard digits):
   with event location for lift-off (N = 0 while decreasing) and for v_rel = 0;
 * rolling: closed form.
 
+Typical cost at the default precision (chapter parameters, Ω = 184 rad/s): one
+``mp_flight`` ~10 ms; ``mp_first_impact`` ~60 ms per forcing period searched;
+``mp_impact_sequence`` ~20 ms per impact; ``mp_sliding`` (dps 40) ~0.5-1 s per
+forcing period of contact.
+
 Parameters are passed as a plain dict with keys
 ``m, c, k, e_c, phi, c_r, R, mu, d, g, levitate``.  Complex inputs may be Python
 ``complex``; results are mpmath ``mpf``/``mpc`` values carrying the working
