@@ -1,0 +1,113 @@
+"""Rigorous impact location: grazing excursions of 1e-10 c_r, accuracy, invariants, work."""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import pytest
+
+from rotortd import RotorParams, TouchdownCore, work_cap
+from rotortd.events import EPS, ContactLocator, Work
+from rotortd.flight import FlightModel
+from tests.reference.mp_reference import mp_first_impact
+
+W0 = 184.2
+BASE = RotorParams()
+
+
+def _par(p: RotorParams) -> dict:
+    return {f: getattr(p, f) for f in p.__dataclass_fields__}
+
+
+def _offset_whirl(excess: float) -> tuple[RotorParams, complex, complex, float]:
+    """A steady whirl z = Z0 + Z1 e^{i psi} whose largest radius is c_r (1 + excess).
+
+    A constant force shifts the orbit off-centre by Z0; the start is the point nearest the
+    centre, so both ends of a one-period step lie well inside.
+    """
+    p = BASE.replace(c=0.3 * BASE.m * W0)
+    fm = FlightModel(p, W0, 0j, 1.0)
+    Z1 = fm.F1 / complex(fm.kappa - W0**2, fm.beta * W0)  # at psi = 0
+    Z0_mag = p.c_r * (1.0 + excess) - abs(Z1)
+    F = Z0_mag * p.m * fm.kappa * cmath.exp(1j * cmath.phase(Z1))  # Z0 along Z1(psi=0)
+    psi0 = math.pi  # start opposite: |z| = |Z1| - |Z0|
+    E0 = cmath.exp(1j * psi0)
+    z0 = F / (p.m * fm.kappa) + Z1 * E0
+    v0 = 1j * W0 * Z1 * E0
+    return p, F, z0, v0
+
+
+@pytest.mark.parametrize("excess", [1e-10, -1e-10])
+def test_grazing_within_one_long_step(excess: float) -> None:
+    p, F, z0, v0 = _offset_whirl(excess)
+    core = TouchdownCore(p, z0, v0, psi0=math.pi)
+    period = 2 * math.pi / W0
+    rep = core.step(3 * period, W0, F)
+    if excess > 0:
+        assert len(rep.impacts) >= 1, "an excursion of 1e-10 c_r beyond the wall was missed"
+        imp = rep.impacts[0]
+        assert imp.t == pytest.approx(0.5 * period, rel=1e-4)  # near the far point
+        assert abs(imp.z) == pytest.approx(p.c_r, rel=4 * EPS)
+    else:
+        assert rep.impacts == [], "a miss by 1e-10 c_r produced an impact"
+    assert abs(core.z) <= p.c_r * (1 + 1e-12)
+
+
+def test_grazing_time_matches_high_precision_reference() -> None:
+    p, F, z0, v0 = _offset_whirl(1e-8)
+    fm = FlightModel(p, W0, F, 1.0)
+    hit = ContactLocator(fm, z0, v0, cmath.exp(1j * math.pi)).find(0.05, False, Work())
+    assert hit is not None and hit.kind == "impact"
+    ref = mp_first_impact(_par(p), z0, v0, math.pi, W0, F, 1.0, 0.05, dps=40)
+    t_ref, _, v_ref = ref
+    rdot = (hit.z.conjugate() * hit.v).real / abs(hit.z)
+    # time within a small multiple of eps (c_r/rdot + t)
+    bound = 8 * EPS * (p.c_r / rdot + hit.s)
+    assert abs(hit.s - float(t_ref)) <= bound, (hit.s - float(t_ref), bound)
+    # near grazing the impact speed grows like sqrt(excess): rdot ~ sqrt(2 g'' excess c_r^2)
+    assert rdot < 1e-3 * p.c_r * W0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_impact_times_match_reference(seed: int) -> None:
+    """Random flights from inside at the chapter's parameters: first impact vs mpmath."""
+    import random
+
+    rng = random.Random(seed)
+    p = BASE.replace(c=rng.uniform(0.05, 0.3) * BASE.m * W0)
+    z0 = p.c_r * rng.uniform(0, 0.9) * cmath.exp(1j * rng.uniform(-3, 3))
+    v0 = p.c_r * W0 * rng.uniform(0, 1.5) * cmath.exp(1j * rng.uniform(-3, 3))
+    psi0 = rng.uniform(-3, 3)
+    fm = FlightModel(p, W0, 0j, 1.0)
+    hit = ContactLocator(fm, z0, v0, cmath.exp(1j * psi0)).find(0.1, False, Work())
+    ref = mp_first_impact(_par(p), z0, v0, psi0, W0, 0j, 1.0, 0.1, dps=30)
+    if ref is None:
+        assert hit is None
+        return
+    assert hit is not None
+    rdot = (hit.z.conjugate() * hit.v).real / abs(hit.z)
+    assert abs(hit.s - float(ref[0])) <= 8 * EPS * (p.c_r / rdot + hit.s)
+    assert abs(hit.z - complex(ref[1])) <= 8 * EPS * p.c_r + 8 * EPS * abs(hit.v) * hit.s
+
+
+def test_step_invariants_and_work_cap_over_random_scene() -> None:
+    p = BASE.replace(c=0.1 * BASE.m * W0)
+    core = TouchdownCore(p, 0.5 * p.c_r, 0.8j * p.c_r * W0)
+    for i in range(2000):
+        h = 1e-4 * (1 + (i % 7))
+        rep = core.step(h, W0)
+        assert rep.status == 0
+        assert abs(core.z) <= p.c_r * (1 + 1e-12)
+        assert rep.work <= work_cap(p, h, W0, 0j, 1.0)
+        for imp in rep.impacts:
+            assert abs(abs(imp.z) - p.c_r) <= 4 * EPS * p.c_r
+    assert core.n_impacts > 10
+
+
+def test_free_whirl_skips_the_search() -> None:
+    """A scene that provably never reaches the wall does one propagation per step."""
+    p = BASE.replace(c=0.3 * BASE.m * W0)
+    core = TouchdownCore.on_steady_whirl(p, W0)
+    works = [core.step(1e-3, W0).work for _ in range(100)]
+    assert works[0] <= 2 and max(works[1:]) == 1
