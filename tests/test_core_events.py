@@ -6,10 +6,10 @@ import cmath
 import math
 
 import pytest
-
 from rotortd import RotorParams, TouchdownCore, work_cap
 from rotortd.events import EPS, ContactLocator, Work
 from rotortd.flight import FlightModel
+
 from tests.reference.mp_reference import mp_first_impact
 
 W0 = 184.2

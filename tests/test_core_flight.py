@@ -11,9 +11,9 @@ import math
 
 import mpmath
 import pytest
-
 from rotortd import RotorParams, TouchdownCore
 from rotortd.flight import FlightModel
+
 from tests.reference.mp_reference import mp_flight
 
 EPS = 2.220446049250313e-16

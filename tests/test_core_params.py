@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import pytest
-
 from rotortd import InputError, ParameterError, RotorParams, TouchdownCore
 
 BAD = [
