@@ -166,7 +166,8 @@ def sc_match_core(fmu: str, params: dict, n: int, h: float, t_off: float | None 
     mismatches = [(i, k, fmu_rows[i][k], core_rows[i][k]) for i in range(n)
                   for k in core_rows[i] if fmu_rows[i][k] != core_rows[i][k]]
     return {"mismatches": mismatches[:10], "n_mismatch": len(mismatches),
-            "n_impacts": fmu_rows[-1]["n_impacts"], "core_file": rotortd.__file__}
+            "n_impacts": fmu_rows[-1]["n_impacts"], "core_file": rotortd.__file__,
+            "modes": sorted({r["mode"] for r in fmu_rows})}
 
 
 def _run_core(rotortd: Any, params: dict, n: int, h: float, Omega: float,
@@ -215,6 +216,7 @@ def sc_state_roundtrip(fmu: str, params: dict, n1: int, n2: int, h: float,
     inst.init(params)
     _run(inst, n1, h, inputs)
     t_saved = inst.t
+    n_at_save = inst.outputs()["n_impacts"]
     state = inst.slave.getFMUstate()
     blob = bytes(inst.slave.serializeFMUstate(state))
     run_a = _run(inst, n2, h, inputs)
@@ -232,6 +234,7 @@ def sc_state_roundtrip(fmu: str, params: dict, n1: int, n2: int, h: float,
     doc = json.loads(blob.decode())
     return {"same_get_set": run_a == run_b, "same_serialized": run_a == run_c,
             "n_impacts": [run_a[-1]["n_impacts"], run_c[-1]["n_impacts"]],
+            "n_impacts_at_save": n_at_save,
             "schema": doc.get("schema"), "version": doc.get("version"),
             "has_core": isinstance(doc.get("core"), dict),
             "core_schema": (doc.get("core") or {}).get("schema"),

@@ -132,23 +132,42 @@ def test_step_size_independence_transient_free(fmu_path: Path) -> None:
     _assert_same_state(res["one"], res["many"], 1e-12 * C_R, 1e-12 * C_R * OMEGA)
 
 
+def test_step_size_independence_short_impacting_scene(fmu_path: Path) -> None:
+    """Default scene up to 40 ms (three impacts): one step vs 1000 steps. Impacts amplify
+    rounding differences, so velocities get a 10x looser bound than positions."""
+    res = run_scenario(fmu_path, "step_independence", params={}, T=0.04, n=1000)
+    assert res["one"]["n_impacts"] >= 2, "scene no longer impacts; pick another"
+    _assert_same_state(res["one"], res["many"], 1e-12 * C_R, 1e-11 * C_R * OMEGA)
+    assert abs(res["one"]["t_last_impact"] - res["many"]["t_last_impact"]) <= 1e-12 / OMEGA
+
+
 def test_state_get_set_and_serialize_round_trip(fmu_path: Path) -> None:
-    res = run_scenario(fmu_path, "state_roundtrip", params={"g": 9.81}, n1=150, n2=150,
-                       h=1e-4, t_off=0.005)
+    """Save at 140 ms of an AMB failure (t_off = 10 ms, g = 9.81), replay 60 ms: with the
+    current core this crosses impacts and sustained contact (sliding, rolling)."""
+    res = run_scenario(fmu_path, "state_roundtrip", params={"g": 9.81}, n1=1400, n2=600,
+                       h=1e-4, t_off=0.01)
     assert res["schema"] == "rotortd-fmu-state" and res["version"] == 1
     assert res["has_core"] and res["core_schema"] == "rotortd-state"
     assert res["same_get_set"], "get/set FMU state did not reproduce the run bit for bit"
     assert res["same_serialized"], "serialize/deserialize did not reproduce the run"
+    crossed_events = res["n_impacts"][0] > res["n_impacts_at_save"] or len(res["modes"]) > 1
+    assert crossed_events, f"replay window has no event any more; move it: {res}"
 
 
 def test_amb_failure_with_gravity_ends_in_contact(fmu_path: Path) -> None:
-    """amb_on 1 -> 0 at 10 ms with g = 9.81: the rotor drops onto the bearing.
-    The sustained-contact physics lands later; assert only what the core delivers now:
-    the rotor reaches the clearance and either impacts or is in contact."""
-    res = run_scenario(fmu_path, "amb_drop", n=1000, h=1e-4, t_off=0.01)
-    assert math.isclose(res["t_end"], 0.1, abs_tol=1e-9)
+    """amb_on 1 -> 0 at 10 ms with g = 9.81, 0.5 s: the rotor drops onto the bearing.
+    The brief asks only for 'in contact or impacts' because sustained contact was landing in
+    parallel; today's core ends this scene rolling (mode 2) after ~280 impacts."""
+    res = run_scenario(fmu_path, "amb_drop", n=5000, h=1e-4, t_off=0.01)
+    assert math.isclose(res["t_end"], 0.5, abs_tol=1e-9)
     assert res["any_contact"] or res["n_impacts"] > 0, res
     assert res["r_max"] > 0.999
+
+
+def test_fmu_matches_core_through_sustained_contact(fmu_path: Path) -> None:
+    res = run_scenario(fmu_path, "match_core", params={"g": 9.81}, n=2000, h=1e-4, t_off=0.01)
+    assert res["n_mismatch"] == 0, res["mismatches"]
+    assert res["modes"] != [0], "scene no longer reaches sustained contact"
 
 
 BAD_PARAMS = [
@@ -226,3 +245,29 @@ def test_default_scene_fine_output_matches_core(fmu_path: Path) -> None:
     """The whole default scene (0.5 s at 1e-4) bit for bit against the core."""
     res = run_scenario(fmu_path, "match_core", params={}, n=5000, h=1e-4, timeout=900)
     assert res["n_mismatch"] == 0, res["mismatches"]
+
+
+@pytest.mark.slow
+def test_normal_interpreter_exit_after_fmu_use(fmu_path: Path) -> None:
+    """PythonFMU once showed 'corrupted double-linked list' at interpreter shutdown (after all
+    results were out). The scenarios avoid teardown with os._exit; this test runs the plain
+    path ten times, requires the results, and only warns about crashes at exit."""
+    code = (
+        "import sys\nfrom fmpy import simulate_fmu\n"
+        "r = simulate_fmu(sys.argv[1], stop_time=0.05, output_interval=1e-4,"
+        " start_values={'g': 9.81})\n"
+        "r = simulate_fmu(sys.argv[1], stop_time=0.05, output_interval=1e-4,"
+        " debug_logging=True, start_values={'m': -1.0})\n"
+        "print('DONE', flush=True)\n")
+    exit_crashes = []
+    for _ in range(10):
+        proc = subprocess.run([sys.executable, "-c", code, str(fmu_path)], capture_output=True,
+                              text=True, timeout=120)
+        assert "DONE" in proc.stdout, proc.stderr[-2000:]
+        if proc.returncode != 0:
+            exit_crashes.append((proc.returncode, proc.stderr[-300:]))
+    if exit_crashes:
+        import warnings
+
+        warnings.warn(f"crash at interpreter exit in {len(exit_crashes)}/10 runs: "
+                      f"{exit_crashes[0]}", stacklevel=1)
