@@ -61,6 +61,7 @@ def test_grazing_time_matches_high_precision_reference() -> None:
     assert hit is not None and hit.kind == "impact"
     ref = mp_first_impact(_par(p), z0, v0, math.pi, W0, F, 1.0, 0.05, dps=40)
     t_ref, _, v_ref = ref
+    assert abs(hit.v - complex(v_ref)) <= 1e-9 * abs(hit.v)
     rdot = (hit.z.conjugate() * hit.v).real / abs(hit.z)
     # time within a small multiple of eps (c_r/rdot + t)
     bound = 8 * EPS * (p.c_r / rdot + hit.s)

@@ -93,7 +93,6 @@ class WallForces:
         return max(
             abs(self.Omega),
             abs(dtheta),
-            abs(self.wr),
             math.sqrt(self.kappa),
             self.beta,
             math.sqrt(abs(self.q0) + abs(self.eu)),

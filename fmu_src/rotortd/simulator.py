@@ -15,7 +15,7 @@ contact begins when
   (1) h_b <= ETA_HEIGHT c_r (the remaining chattering cascade is below resolution), or
   (2) the cascade to (1) would need more than N_CASCADE further impacts (d close to 1,
       or d = 1 where it never ends) and the bounce is short, tau_b <= ETA_TIME/w_ref,
-      w_ref = max(|Omega|, |theta'|, R|Omega|/c_r, sqrt(kappa), beta, sqrt(A/c_r)).
+      w_ref = max(|Omega|, |theta'|, sqrt(kappa), beta, sqrt(A/c_r)).
 
 Rule (1) replaces a cascade with total normal momentum m(1+d)v/(1-d) by a plastic impact
 m v plus sliding, which delivers the rest in the accumulation time 2 d v/((1-d) A): the
@@ -51,6 +51,7 @@ from .params import InputError, ParameterError, RotorParams, check_finite, check
 MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
 STATUS_OK, STATUS_WORK_CAP, STATUS_ACCUMULATION = 0, 1, 2
 STATE_SCHEMA, STATE_VERSION = "rotortd-state", 1
+_MODE_NAMES = {MODE_FREE: "lift_off", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
 
 ETA_HEIGHT = 1e-14
 """Rule (1): rebound height below ETA_HEIGHT c_r counts as contact."""
@@ -87,6 +88,8 @@ class StepReport:
     E_diss: float = 0.0
     mode: int = MODE_FREE
     work: int = 0
+    transitions: list[tuple[float, str]] = field(default_factory=list)
+    """Mode changes in the step: (t, "sliding" | "rolling" | "lift_off")."""
 
 
 @dataclass(frozen=True)
@@ -124,6 +127,7 @@ class _Tally:
         self.P_t = 0.0  # N s, signed friction impulse (torque impulse = -R P_t)
         self.E = 0.0  # J
         self.peak = 0.0  # N
+        self.transitions: list[tuple[float, str]] = []  # (t, kind)
 
     def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
         self.P_vec += mc * tal.I_c
@@ -179,6 +183,7 @@ class TouchdownCore:
             )
         self._p = params
         self._t = float(t0)
+        self._t_lo = 0.0  # compensation of the clock (Kahan), s
         self._z, self._v = z0, v0
         self._psi, self._turns = wrap_angle(float(psi0)), 0
         self._turns = round((float(psi0) - self._psi) / _TWO_PI_HI)
@@ -376,12 +381,22 @@ class TouchdownCore:
             while s < h:
                 if work.total > cap:
                     raise WorkCapExceeded(f"step work exceeded its cap {cap}")
+                mode = self._mode
                 s = self._advance(s, h, t0, tally, work)
+                if self._mode != mode:
+                    tally.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
         except (WorkCapExceeded, SearchExhausted, ContactWorkExceeded) as exc:
             rep.status, rep.message = STATUS_WORK_CAP, f"t = {t0 + s!r} s: {exc}"
-        self._t = t0 + h if s >= h else t0 + s
+        self._tick(h if s >= h else s)
         self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
         return rep
+
+    def _tick(self, dt: float) -> None:
+        """Advance the clock by dt with compensated summation (no drift over 1e6 steps)."""
+        y = dt - self._t_lo
+        t = self._t + y
+        self._t_lo = (t - self._t) - y
+        self._t = t
 
     def _set_inputs(self, W: float, F: complex, a: float) -> None:
         if (W, F, a) != self._inputs or self._fm is None:
@@ -402,6 +417,7 @@ class TouchdownCore:
         rep.E_diss = tal.E
         rep.mode = self._mode
         rep.work = work.total
+        rep.transitions = tal.transitions
         self._E_diss += tal.E
 
     def _advance(self, s: float, h: float, t0: float, tally: _Tally, work: Work) -> float:
@@ -628,6 +644,7 @@ class TouchdownCore:
             "version": STATE_VERSION,
             "params": {f: getattr(p, f) for f in p.__dataclass_fields__},
             "t": self._t,
+            "t_lo": self._t_lo,
             "z": [self._z.real, self._z.imag],
             "v": [self._v.real, self._v.imag],
             "psi": self._psi,
@@ -661,6 +678,7 @@ class TouchdownCore:
             )
         self._p = RotorParams(**st["params"])
         self._t = float(st["t"])
+        self._t_lo = float(st["t_lo"])
         self._z = complex(*st["z"])
         self._v = complex(*st["v"])
         self._psi, self._turns = float(st["psi"]), int(st["turns"])
