@@ -310,6 +310,16 @@ def sc_impact_log(fmu: str, n: int, h: float, t_off: float) -> dict[str, Any]:
     return {"n_impacts": rows[-1]["n_impacts"], "csv": text}
 
 
+def sc_bad_state(fmu: str, blob: str) -> dict[str, Any]:
+    inst = Instance(fmu)
+    inst.init({})
+    _run(inst, 5, 1e-4)
+    state = inst.slave.deSerializeFMUstate(blob.encode())
+    inst.slave.setFMUstate(state)
+    inst.slave.freeFMUstate(state)
+    return {"status": inst.step(1e-4), "messages": [m["message"] for m in MESSAGES]}
+
+
 SCENARIOS: dict[str, Callable[..., dict[str, Any]]] = {
     name[3:]: fn for name, fn in globals().items() if name.startswith("sc_")
 }

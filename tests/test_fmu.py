@@ -154,6 +154,14 @@ def test_state_get_set_and_serialize_round_trip(fmu_path: Path) -> None:
     assert crossed_events, f"replay window has no event any more; move it: {res}"
 
 
+@pytest.mark.parametrize("blob", ["not json", '{"schema": "rotortd-fmu-state", "version": 99}',
+                                  '{"schema": "other"}', "[1, 2]"])
+def test_corrupt_serialized_state_is_refused_without_crash(fmu_path: Path, blob: str) -> None:
+    res = run_scenario(fmu_path, "bad_state", blob=blob)
+    assert res["status"] == 2, res
+    assert any("setFMUstate failed" in m for m in res["messages"]), res["messages"]
+
+
 def test_amb_failure_with_gravity_ends_in_contact(fmu_path: Path) -> None:
     """amb_on 1 -> 0 at 10 ms with g = 9.81, 0.5 s: the rotor drops onto the bearing.
     The brief asks only for 'in contact or impacts' because sustained contact was landing in
