@@ -56,14 +56,10 @@ def _alpha_from_equilibrium(gamma: float) -> float:
     sp = p.scaled(W0)
     # scaled: rho (sin x - mu cos x) = gamma + mu (1 - omega^2), x = phi - alpha, and
     # stability needs rho (cos x + mu sin x) > 0
-    f = lambda x: (
-        sp.rho * (mpmath.sin(x) - sp.mu * mpmath.cos(x))
-        - sp.gamma
-        - sp.mu
-        * (  # noqa: E731
-            1 - sp.omega**2
-        )
-    )
+    def f(x: mpmath.mpf) -> mpmath.mpf:
+        lhs = sp.rho * (mpmath.sin(x) - sp.mu * mpmath.cos(x))
+        return lhs - sp.gamma - sp.mu * (1 - sp.omega**2)
+
     for x0 in (0.5, 1.0, 1.5, 2.0, 2.5):
         x = mpmath.findroot(f, x0)
         if sp.rho * (mpmath.cos(x) + sp.mu * mpmath.sin(x)) > 0:
