@@ -139,6 +139,7 @@ REAL_OUTPUTS: tuple[tuple[str, str], ...] = (
     ("E_diss", "Energy dissipated by contact, cumulative [J], >= 0"),
 )
 
+STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core-api.md)
 IMPACT_LOG_HEADER = "time,x,y,vx_minus,vy_minus,vx_plus,vy_plus,rdot,P_n,P_t,stick\n"
 
 
@@ -149,6 +150,13 @@ class ModelError(ValueError):
 def _check_finite(name: str, value: float) -> None:
     if not math.isfinite(value):
         raise ModelError(f"{name}={value!r} is not finite")
+
+
+def _time_tolerance(t: float, step_size: float) -> float:
+    """Allowed gap between the host's communication point and the model time: host clocks
+    that add h up naively drift by rounding (the core's clock is compensated); a gap of a
+    sizeable fraction of a step means a skipped, repeated or rolled-back step."""
+    return 1e-9 * max(1.0, abs(t)) + 1e-2 * step_size
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -254,8 +262,7 @@ class RotorTouchdown(Fmi2Slave):
             self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
             return False
         try:
-            self._step(current_time, step_size)
-            return True
+            return self._step(current_time, step_size)
         except Exception as exc:
             self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
             return False
@@ -325,7 +332,7 @@ class RotorTouchdown(Fmi2Slave):
                 _check_finite(name, value)
             self._core.set_params(params.replace(**changes))
 
-    def _step(self, current_time: float, step_size: float) -> None:
+    def _step(self, current_time: float, step_size: float) -> bool:
         if self._core is None:
             raise ModelError("do_step before exitInitializationMode")
         self._check_fixed()
@@ -333,20 +340,33 @@ class RotorTouchdown(Fmi2Slave):
         self._apply_tunables()
         if not step_size > 0.0:
             raise ModelError(f"communication step size {step_size!r} must be > 0")
-        tol = 1e-9 * max(1.0, abs(current_time)) + 1e-6 * step_size
-        if abs(current_time - self._core.t) > tol:
+        if abs(current_time - self._core.t) > _time_tolerance(current_time, step_size):
             raise ModelError(f"communication point {current_time!r} does not match the "
                              f"model time {self._core.t!r}")
         omega, f_ext, amb = self._input_values()
+        t_target = self._core.t + step_size
         rep = self._core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
-        if rep.status != 0:
-            self.log(f"t={self._core.t!r}: core status {rep.status}: {rep.message}",
-                     Fmi2Status.warning)
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         self._publish_kinematics(omega, amb)
         self._publish_counters()
         self._publish_step_outputs(rep, len(rep.impacts))
+        return self._judge_report(rep, t_target, step_size)
+
+    def _judge_report(self, rep: Any, t_target: float, step_size: float) -> bool:
+        """A step the core could not finish (work cap) is refused: the outputs show the
+        state where it stopped and the model time stays there (restore a saved FMU state or
+        continue from core time). A completed step with a non-OK status is a warning."""
+        reached = self._core.t
+        short = abs(reached - t_target) > _time_tolerance(t_target, step_size)
+        if rep.status == STATUS_WORK_CAP or short:
+            self.log(f"step incomplete: core status {rep.status} ({rep.message}); model time "
+                     f"stays at t={reached!r} instead of {t_target!r}", Fmi2Status.error)
+            return False
+        if rep.status != 0:
+            self.log(f"t={reached!r}: core status {rep.status}: {rep.message}",
+                     Fmi2Status.warning)
+        return True
 
     # ------------------------------------------------------------------ publishing
     def _publish_kinematics(self, omega: float, amb: float) -> None:
