@@ -9,7 +9,9 @@ post-processed (units with <UnitDefinitions>, min/max of bounded variables, a co
 validated with fmpy and `fmutool -check`; the script exits non-zero on any problem.
 
 To add an FMU (e.g. Drivetrain), append an FmuSpec to FMU_SPECS: its script must define a
-``VARIABLE_META`` dict {name: (unit, min, max)} next to the Fmi2Slave class.
+``VARIABLE_META`` dict {name: (unit, min, max)} next to the Fmi2Slave class, declare the class
+as ``class Name(Fmi2Slave):`` (PythonFMU finds it by that regex), and use a script name and
+package names of its own: every PythonFMU instance in a process shares ``sys.modules``.
 """
 
 from __future__ import annotations
