@@ -34,8 +34,8 @@ from .params import RotorParams
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""
-MAX_STEPS = 20000
-"""Cap on integrator steps (accepted + rejected) in one sliding segment."""
+MAX_STEPS = 2000
+"""Cap on integrator steps in one sliding segment, plus 10 per maximal step in it."""
 MAX_ROOT_ITERS = 200
 """Cap on conservative-advancement iterations for one rolling exit search."""
 
@@ -87,6 +87,21 @@ class WallForces:
         """(Gn, Gt) in 1/s^2 at angle theta, whirl rate dtheta and phasor E = e^{i psi}."""
         P = (self.q0 + self.eu * E) * complex(math.cos(theta), -math.sin(theta))
         return P.real - self.kappa + dtheta * dtheta, P.imag - self.beta * dtheta
+
+    def gn_rate(self, theta: float, dtheta: float, E: complex, ddtheta: float) -> float:
+        """dGn/dt (1/s^3) along a contact motion with angular acceleration ddtheta."""
+        w = complex(math.cos(theta), -math.sin(theta))
+        Q = self.q0 + self.eu * E
+        dP = (1j * self.Omega * self.eu * E - 1j * dtheta * Q) * w
+        return dP.real + 2.0 * dtheta * ddtheta
+
+    def gn_tol(self, dtheta: float) -> float:
+        """Rounding band of Gn (1/s^2): inside it the sign of dGn/dt decides lift-off."""
+        return (
+            64.0
+            * 2.220446049250313e-16
+            * (abs(self.q0) + abs(self.eu) + self.kappa + dtheta * dtheta)
+        )
 
     def omega_ref(self, dtheta: float) -> float:
         """A frequency scale (rad/s) of the contact motion, for step limits and tolerances."""
@@ -170,7 +185,7 @@ class Sliding:
         H = min(H0, self.h_max)
         tally = ContactTally()
         tally.peak = max(0.0, self.events(y, 0.0)[0])
-        for _ in range(MAX_STEPS):
+        for _ in range(MAX_STEPS + int(min(10.0 * rem / self.h_max, 1e9))):
             if u >= rem:
                 break
             step = min(H, rem - u)
@@ -190,7 +205,7 @@ class Sliding:
             u, y = u_next, y_new
             H = min(gbs.next_step_size(step, err, k), self.h_max)
         else:
-            raise ContactWorkExceeded(f"sliding segment exceeded {MAX_STEPS} steps")
+            raise ContactWorkExceeded("sliding segment exceeded its step cap")
         self._tally(tally, y)
         return SegmentEnd(rem, y[0], y[1], None, tally), H
 

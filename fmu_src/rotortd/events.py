@@ -171,6 +171,19 @@ class ContactLocator:
         z, v = self.fm.propagate(self.z0, self.v0, self.E0, s)
         return z, v, self.E0 * cmath.exp(1j * self.fm.Omega * s)
 
+    def g3(self, z: complex, v: complex, E: complex) -> float:
+        """Exact third derivative of g (m^2/s^3) of the free flight at (z, v, E)."""
+        acc = self.fm.accel(z, v, E)
+        jerk = self.fm.jerk(v, acc, E)
+        return 6.0 * (v.conjugate() * acc).real + 2.0 * (z.conjugate() * jerk).real
+
+    def grace_step(self, z: complex, v: complex, E: complex) -> float:
+        """Time (s) a tangential departure (g = g' = 0, g'' at rounding level, g3 < 0)
+        needs to get 8 TOL_G inside: (48 TOL_G/|g3|)^(1/3). There g'' is noise and the
+        cubic term governs, so no contact can occur within it."""
+        g3 = self.g3(z, v, E)
+        return (48.0 * self.tol_g / max(-g3, 1e-300)) ** (1.0 / 3.0)
+
     def g3_bound(self, v: complex, tau: float) -> float:
         """Bound G3 (m^2/s^3) of |g'''| on an interval of length tau starting at velocity v."""
         fm = self.fm
@@ -194,6 +207,10 @@ class ContactLocator:
                 if hit is not None:
                     return hit
                 g, g1 = 0.0, min(g1, 0.0)
+                if g1 == 0.0 and g2 >= 0.0 and s < h:  # tangential departure, g3 < 0
+                    s = min(h, s + self.grace_step(z, v, E))
+                    z, v, E = self.state(s, work)
+                    continue
             remaining = h - s
             if remaining <= 0.0:
                 return None
@@ -246,7 +263,10 @@ class ContactLocator:
             if first:
                 return Contact(s, z, v, E, "impact")
             return self._polish(s, z, v, E, g, g1, work)
-        if g2 > 0.0 and g1 >= -tol_g1:
+        if g1 < -tol_g1:
+            return None
+        tol_g2 = 64.0 * EPS * (abs(v) ** 2 + self.fm.c_r * abs(self.fm.accel(z, v, E)))
+        if g2 > tol_g2 or (g2 >= -tol_g2 and self.g3(z, v, E) > 0.0):
             return Contact(s, z, v, E, "touch")
         return None
 

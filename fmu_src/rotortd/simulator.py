@@ -63,7 +63,7 @@ LOCK_TOL = 1e-13
 """Sliding state within LOCK_TOL (rad, and relative in rate) of a stable forward-rub
 equilibrium is advanced as a rigid rotation."""
 WORK_BASE = 20_000
-WORK_PER_RADIAN = 20_000
+WORK_PER_RADIAN = 100_000
 """Work cap of one step: WORK_BASE + WORK_PER_RADIAN * h * w_max (see work_cap)."""
 _R_CLEAR = 1.0 - 1e-9
 _TWO_PI_HI, _TWO_PI_LO = 6.283185307179586, 2.4492935982947064e-16
@@ -88,6 +88,7 @@ class StepReport:
     E_diss: float = 0.0
     mode: int = MODE_FREE
     work: int = 0
+    work_cap: int = 0
     transitions: list[tuple[float, str]] = field(default_factory=list)
     """Mode changes in the step: (t, "sliding" | "rolling" | "lift_off")."""
 
@@ -137,12 +138,15 @@ class _Tally:
         self.peak = max(self.peak, mc * tal.peak)
 
 
-def work_cap(p: RotorParams, h: float, Omega: float, F_ext: complex, amb: float) -> int:
+def work_cap(
+    p: RotorParams, h: float, Omega: float, F_ext: complex, amb: float, speed: float = 0.0
+) -> int:
     """Documented cap on the work counter of one step of length h (s).
 
     WORK_BASE + WORK_PER_RADIAN * h * w_max, where w_max (rad/s) is the largest rate in
-    the scene: |Omega|, R|Omega|/c_r (rolling whirl), sqrt(k/m), c/m, and the rate
-    sqrt(F/(m c_r)) at which the largest force moves the rotor across the clearance.
+    the scene: |Omega|, R|Omega|/c_r (rolling whirl), sqrt(k/m), c/m, the rate
+    sqrt(F/(m c_r)) at which the largest force moves the rotor across the clearance, and
+    the rate speed/c_r of the rotor's own speed (m/s) at the start of the step.
     """
     force = abs(F_ext) + p.m * p.g + amb * p.m * p.g * p.levitate + p.m * p.e_c * Omega**2
     w_max = max(
@@ -151,6 +155,7 @@ def work_cap(p: RotorParams, h: float, Omega: float, F_ext: complex, amb: float)
         math.sqrt(amb * p.k / p.m),
         amb * p.c / p.m,
         math.sqrt(force / (p.m * p.c_r)),
+        speed / p.c_r,
     )
     return int(WORK_BASE + WORK_PER_RADIAN * min(h * w_max, 1e12))
 
@@ -374,8 +379,8 @@ class TouchdownCore:
         self._set_inputs(W, F, a)
         tally = _Tally()
         work = Work()
-        cap = work_cap(self._p, h, W, F, a)
-        rep = StepReport()
+        cap = work_cap(self._p, h, W, F, a, abs(self._v))
+        rep = StepReport(work_cap=cap)
         t0, s = self._t, 0.0
         try:
             while s < h:
@@ -559,8 +564,7 @@ class TouchdownCore:
         E = self._phasor()
         if self._mode == MODE_ROLLING and wf.wr + self._dtheta != 0.0:
             self._choose_contact_mode()  # the spin changed: slip until it rolls again
-        gn, _ = wf.gn_gt(self._theta, self._dtheta, E)
-        if gn <= 0.0:
+        if self._leaves_wall(E):
             self._lift_off()
             return s
         if self._mode == MODE_ROLLING:
@@ -578,6 +582,21 @@ class TouchdownCore:
         self._transition(end.event)
         self._sync_from_contact()
         return s + end.du if end.du < rem else h
+
+    def _leaves_wall(self, E: complex) -> bool:
+        """Lift-off at the start of a contact segment: N < 0, or N = 0 to rounding and
+        decreasing (the same tie-break as the free flight's touch test, so the two never
+        disagree and hand the state back and forth)."""
+        wf = self._wf
+        assert wf is not None
+        gn, gt = wf.gn_gt(self._theta, self._dtheta, E)
+        tol = wf.gn_tol(self._dtheta)
+        if gn > tol:
+            return False
+        if gn < -tol:
+            return True
+        dd = 0.0 if self._mode == MODE_ROLLING else gt - wf.mu * self._slip * gn
+        return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0
 
     def _transition(self, event: str | None) -> None:
         wf = self._wf
