@@ -36,7 +36,8 @@ EPS = 2.220446049250313e-16
 TOL_G_ULPS = 64.0
 """Contact resolution: g >= -TOL_G_ULPS * eps * c_r^2 counts as at the wall."""
 MAX_ADVANCES = 400
-"""Cap on conservative-advancement iterations in one search (a grazing pass needs ~40)."""
+"""Advances in one search call (a grazing pass needs ~40); a flight creeping along the
+wall for long may need more, and the caller then resumes from where the search stopped."""
 
 
 @dataclass
@@ -56,8 +57,9 @@ class Work:
 class Contact:
     """First contact of a flight: local time ``s`` (s), state z (m), v (m/s), phasor E.
 
-    ``kind`` is "impact" (moving outward, normal speed resolved) or "touch" (normal speed
-    zero to resolution, free motion curving outward into the wall).
+    ``kind`` is "impact" (moving outward, normal speed resolved), "touch" (normal speed
+    zero to resolution, free motion curving outward into the wall) or "clear" (no contact
+    up to ``s``: the search used its MAX_ADVANCES and the caller resumes from there).
     """
 
     s: float
@@ -222,7 +224,7 @@ class ContactLocator:
                 return Contact(s, z, v, E, "touch")
             s = s + u if u < remaining else h
             z, v, E = self.state(s, work)
-        raise SearchExhausted(f"contact search exceeded {MAX_ADVANCES} advances")
+        return Contact(s, z, v, E, "clear")  # proved free of contact up to s; resume there
 
     def _advance(
         self, g: float, g1: float, g2: float, v: complex, remaining: float, work: Work

@@ -462,6 +462,10 @@ class TouchdownCore:
             return h
         ds = min(hit.s, rem)
         self._advance_psi(ds)
+        if hit.kind == "clear":
+            self._z, self._v = hit.z, hit.v
+            self._on_wall = False
+            return s + ds
         z = hit.z * (self._p.c_r / abs(hit.z))
         self._clear = False
         if hit.kind == "impact":

@@ -311,6 +311,9 @@ class ImpactMap:
             hw = min(win, h - s0)
             E = cmath.exp(1j * OMEGA * s0)
             hit = ContactLocator(self.fm, z, v, E).find(hw, s0 == 0.0, Work())
+            if hit is not None and hit.kind == "clear":  # no contact up to hit.s: resume
+                z, v, s0 = hit.z, hit.v, s0 + hit.s
+                continue
             if hit is not None:
                 return hit, s0
             z, v = self.fm.propagate(z, v, E, hw)
