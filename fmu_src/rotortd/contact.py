@@ -218,49 +218,61 @@ class Sliding:
     def _locate(
         self, u: float, y: list[float], f0: list[float], H: float, k: int, tally: ContactTally
     ) -> tuple[float, list[float], str]:
-        """Earliest event in (0, H] by Illinois on re-integrated steps of fixed order."""
+        """Earliest event in (0, H] by Illinois on re-integrated steps of fixed order.
 
-        def at(x: float) -> tuple[list[float], float, float]:
+        The two event functions are normalised by fixed physical scales (not by their
+        value at the start, which is 0 when sliding restarts at zero slip).
+        """
+        wf = self.wf
+        s_n = wf.gn_tol(y[1]) / (64.0 * 2.220446049250313e-16)  # force scale, 1/s^2
+        s_v = abs(wf.wr) + abs(y[1]) + wf.omega_ref(y[1])  # rate scale, 1/s
+
+        def at(x: float) -> tuple[list[float], float]:
             yx, _, _, nfev = gbs.extrapolated_step(
                 self.rhs, u, y, f0, x, self.scale, k_fixed=max(k, 4)
             )
             tally.work += nfev
             gn, sv = self.events(yx, u + x)
-            return yx, gn, sv
+            return yx, min(gn / s_n, sv / s_v)
 
-        y_hi, gn_hi, sv_hi = at(H)
-        lo, hi = 0.0, H
-        # which event comes first: bisect on min of the two normalised event functions
-        sc_n = abs(self.events(y, u)[0]) + 1e-300
-        sc_v = abs(self.events(y, u)[1]) + 1e-300
-
-        def fmin(gn: float, sv: float) -> float:
-            return min(gn / sc_n, sv / sc_v)
-
-        flo, fhi = 1.0, fmin(gn_hi, sv_hi)
+        y_hi, fhi = at(H)
+        gn0, sv0 = self.events(y, u)
+        lo, flo = 0.0, min(gn0 / s_n, sv0 / s_v)
+        if flo <= 0.0:  # starting on the event surface: step off it first
+            x = H * 2.0**-40
+            while x < H:
+                _, fx = at(x)
+                if fx > 0.0:
+                    lo, flo = x, fx
+                    break
+                if x == H * 2.0**-40:
+                    y_x, _ = at(x)
+                    return x, y_x, self._kind(y_x, u + x, s_n, s_v)
+                x *= 2.0
+        hi, y_best = H, y_hi
         side = 0
-        y_best, gn_b, sv_b = y_hi, gn_hi, sv_hi
-        for _ in range(80):
+        for _ in range(100):
             if hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300:
                 break
             x = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
             if not lo < x < hi:
                 x = 0.5 * (lo + hi)
-            yx, gn, sv = at(x)
-            fx = fmin(gn, sv)
+            yx, fx = at(x)
             if fx > 0.0:
                 lo, flo = x, fx
                 if side == -1:
                     fhi *= 0.5
                 side = -1
             else:
-                hi, fhi = x, fx
-                y_best, gn_b, sv_b = yx, gn, sv
+                hi, fhi, y_best = x, fx, yx
                 if side == 1:
                     flo *= 0.5
                 side = 1
-        kind = "lift_off" if gn_b / sc_n <= sv_b / sc_v else "slip_zero"
-        return hi, y_best, kind
+        return hi, y_best, self._kind(y_best, u + hi, s_n, s_v)
+
+    def _kind(self, y: list[float], u: float, s_n: float, s_v: float) -> str:
+        gn, sv = self.events(y, u)
+        return "lift_off" if gn / s_n <= sv / s_v else "slip_zero"
 
 
 # --------------------------------------------------------------------------- rolling

@@ -152,7 +152,8 @@ class FlightModel:
         Z1 = self.F1 * E0 / den
         zeta = z0 - Z0 - Z1
         eta = v0 - 1j * W * Z1
-        return abs(Z0) + abs(Z1) + _transient_bound(beta, kap, zeta, eta)
+        bound = abs(Z0) + abs(Z1) + _transient_bound(beta, kap, zeta, eta)
+        return bound if bound == bound else math.inf  # NaN from inf - inf: no bound
 
 
 def _eigenvalues(beta: float, kappa: float) -> tuple[complex, complex]:
@@ -179,7 +180,7 @@ def _transient_bound(beta: float, kappa: float, zeta: complex, eta: complex) -> 
     best = math.inf
     if disc < 0.0:
         nu = math.sqrt(-disc)
-        best = math.sqrt(nu * nu * abs(zeta) ** 2 + abs(eta + hb * zeta) ** 2) / nu
+        best = math.hypot(nu * abs(zeta), abs(eta + hb * zeta)) / nu
     alpha = kappa / (hb + math.sqrt(max(disc, 0.0))) if disc >= 0.0 else hb  # -Re l1
     if alpha > 0.0:
         A = abs(zeta)
