@@ -1,0 +1,295 @@
+"""Parameter sweeps: specification errors, signatures, Dask = serial, resume after a kill."""
+
+from __future__ import annotations
+
+import cmath
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from rotortd import MODE_ROLLING, MODE_SLIDING
+from rotortd_tools import sweep as sw
+from rotortd_tools.cli import main
+
+SHORT = sw.Settings(transient=60.0, record=30.0)
+
+
+def _rows_by_key(path: Path) -> dict[str, dict]:
+    data = sw.read_sweep(path)
+    keys = data["key"]
+    assert len(keys) == len(set(keys)), "a point is present more than once"
+    return {k: {c: data[c][i] for c in data} for i, k in enumerate(keys)}
+
+
+def _same(a: object, b: object) -> bool:
+    if isinstance(a, float) and isinstance(b, float):
+        return (math.isnan(a) and math.isnan(b)) or a == b
+    return a == b
+
+
+def _assert_identical(ra: dict[str, dict], rb: dict[str, dict]) -> None:
+    assert set(ra) == set(rb)
+    for key in ra:
+        for col, va in ra[key].items():
+            if col == "cpu_s":
+                continue
+            assert _same(va, rb[key][col]), (key, col, va, rb[key][col])
+
+
+def _cycles_available() -> bool:
+    try:
+        sw._cycle_finder()
+    except ImportError:
+        return False
+    return True
+
+
+# --------------------------------------------------------------------------- specification
+
+
+@pytest.mark.parametrize(
+    ("tokens", "starts", "fragment"),
+    [
+        (["gama=0.1:0.2:3"], "rest", "unknown parameter 'gama'"),
+        (["gamma=0.2:0.1:3"], "rest", "lower end must be below"),
+        (["gamma=0.1:0.2"], "rest", "bad range"),
+        (["gamma=0.1:0.2:0"], "rest", "n = 0 must be > 0"),
+        (["gamma=0.1:0.2:-4"], "rest", "must be > 0"),
+        (["gamma=0.1:0.2:x"], "rest", "not an integer"),
+        (["gamma=0.1:0.2:3", "gamma=0.3"], "rest", "gamma is given twice"),
+        (["mu=0.1:0.2:3", "mu=0.1:0.3:3"], "rest", "mu is given twice"),
+        (["d=0.5:1.2:3"], "rest", "d: upper end 1.2 is out of range [0, 1]"),
+        (["d=1.5"], "rest", "d: value 1.5 is out of range"),
+        (["gamma=-0.1:0.2:3"], "rest", "gamma: lower end -0.1 is out of range"),
+        (["Omega=0:100:3"], "rest", "Omega: lower end 0.0 is out of range (0"),
+        (["gamma=abc"], "rest", "'abc' is not a number"),
+        (["gamma"], "rest", "bad token 'gamma'"),
+        (["gamma=0.1:0.2:3", "mu=0:1:3", "d=0:1:3"], "rest", "at most two parameters"),
+        (["gamma=0.1:0.2:3"], "rest,sideways", "unknown start 'sideways'"),
+        (["gamma=0.1:0.2:3"], "cycle:medium", "unknown cycle branch 'medium'"),
+        (["gamma=0.1:0.2:3"], "rest,rest", "given twice"),
+        (["gamma=0.1:0.2:3"], "up:down", "seed cannot be up/down"),
+    ],
+)
+def test_bad_specifications_raise_named_errors(tokens, starts, fragment):
+    with pytest.raises(sw.SweepError, match=None) as err:
+        sw.parse_spec(tokens, starts)
+    assert fragment in str(err.value)
+
+
+def test_cli_bad_specification_exits_2(capsys, tmp_path):
+    rc = main(["sweep", "gamma=0.1:0.2:3", "d=2", "--out", str(tmp_path / "o")])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert "rotortd sweep: error:" in err and "d: value 2.0 is out of range [0, 1]" in err
+    rc = main(["sweep", "gamma=0.1:0.2:3", "--transient", "-1", "--out", str(tmp_path / "o")])
+    assert rc == 2 and "transient" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_missing_cycles_module_gives_clear_error(monkeypatch):
+    def broken():
+        raise ImportError("No module named 'rotortd_tools.cycles'")
+
+    monkeypatch.setattr(sw, "_cycle_finder", broken)
+    with pytest.raises(sw.SweepError, match=r"'cycle' start needs rotortd_tools\.cycles"):
+        sw.parse_spec(["gamma=0.1:0.2:3"], "rest,cycle")
+    sw.parse_spec(["gamma=0.1:0.2:3"], "rest,steady,large,up,down:steady")
+
+
+def test_grid_random_aliases_and_point_order():
+    spec = sw.parse_spec(["gamma=0.1:0.3:5", "R/c_r=40:60:~3", "mu=0.2"], "rest", seed=7)
+    assert spec.axes[0].values == tuple(np.linspace(0.1, 0.3, 5))
+    r = spec.axes[1].values
+    assert spec.axes[1].name == "R_over_cr" and list(r) == sorted(r)
+    assert all(40 <= v <= 60 for v in r)
+    assert sw.parse_spec(["R/c_r=40:60:~3"], "rest", seed=7).axes[0].values != r
+    assert sw.parse_spec(["gamma=0.1:0.2:2", "R/c_r=40:60:~3"], "rest", seed=7
+                         ).axes[1].values == r
+    pts = spec.points()
+    assert len(pts) == 15 and pts[1] == {"gamma": spec.axes[0].values[1], "R_over_cr": r[0]}
+    _, Omega, sp = sw.point_params(spec.values_of(pts[0]))
+    assert (sp.gamma, sp.mu, sp.R_over_cr, Omega) == (0.1, 0.2, r[0], 184.2)
+    _, _, sp2 = sw.point_params({"Omega": 368.4})
+    assert sp2.gamma == pytest.approx(0.152009 / 2, rel=1e-5)
+
+
+# --------------------------------------------------------------------------- signatures
+
+
+def test_detect_period_and_classify():
+    a = [0.1, 0.5] * 20
+    v = [0.7, 0.3] * 20
+    assert sw.detect_period(a, v, 1e-6, 8) == 2
+    assert sw.detect_period([0.2] * 10, [0.5] * 10, 1e-6, 8) == 1
+    rng = np.random.default_rng(1)
+    assert sw.detect_period(list(rng.uniform(size=60)), list(rng.uniform(size=60)), 1e-6, 8) == 0
+    assert sw.detect_period([math.pi - 1e-9, -math.pi + 1e-9] * 2, [1.0] * 4, 1e-6, 4) == 1
+    assert sw.classify(0, 0.0, 0.0, 0) == "free"
+    assert sw.classify(10, 0.0, 0.0, 3) == "period-3"
+    assert sw.classify(10, 0.1, 0.0, 0) == "irregular"
+    assert sw.classify(0, 0.9, 0.1, 0) == "rub"
+    assert sw.classify(0, 0.0, 1.0, 0) == "whip"
+    assert sw.regime_group("period-7") == "period-n"
+
+
+def _run(gamma: float, start: str, settings: sw.Settings | None = None) -> dict:
+    settings = settings or sw.Settings()
+    job = sw.Job(0, (("gamma", gamma),), (("gamma", gamma),), start)
+    return sw.run_job(job, settings)[0]
+
+
+def test_chapter_regimes_from_named_starts():
+    """Free whirl at |U*| from 'steady' above the BEB; rub from rest at 0.3; whip at 0.065."""
+    sp = sw.point_params({"gamma": 0.3})[2]
+    u_star = abs(sp.rho * cmath.exp(1j * sp.phi) / complex(sp.omega**2 - 1, sp.gamma))
+    free = _run(0.3, "steady")
+    assert free["regime"] == "free" and free["n_impacts"] == 0
+    assert free["r_max"] == pytest.approx(u_star, abs=1e-9)
+    rub = _run(0.3, "rest")
+    assert rub["regime"] == "rub" and rub["final_mode"] == MODE_SLIDING
+    assert rub["contact_frac"] == pytest.approx(1.0) and rub["r_min"] == pytest.approx(1.0)
+    whip = _run(0.065, "rest")
+    assert whip["regime"] == "whip" and whip["final_mode"] == MODE_ROLLING
+    below = _run(0.065, "steady")
+    assert below["regime"] == "no-start" and "not admissible" in below["message"]
+
+
+def test_impacting_signature_is_consistent():
+    row = _run(0.1, "rest")
+    assert row["regime"] == "period-1" and row["status"] == "ok"
+    n = row["n_impacts"]
+    assert n > 5 and row["r_max"] == 1.0 and row["contact_frac"] == 0.0
+    assert row["impacts_per_rev"] == pytest.approx(n * 2 * math.pi / 100.0, rel=1e-2)
+    assert row["period_time"] == pytest.approx(2 * math.pi / row["impacts_per_rev"], rel=0.05)
+    sec_v, sec_a = row["sec_speed"], row["sec_angle"]
+    assert len(sec_v) == min(n, 64) and max(sec_v) == row["v_max"]
+    assert max(sec_v) - min(sec_v) < 1e-4 and max(sec_a) - min(sec_a) < 1e-4
+    assert all(-math.pi < a <= math.pi for a in sec_a)
+
+
+@pytest.mark.skipif(not _cycles_available(), reason="rotortd_tools.cycles not available")
+def test_cycle_start_stays_on_stable_cycle():
+    row = _run(0.12, "cycle", SHORT)
+    assert row["status"] == "ok" and row["regime"] == "period-1", row["message"]
+    assert _run(0.29, "cycle", SHORT)["regime"] == "no-start"
+
+
+# --------------------------------------------------------------------------- execution
+
+
+def test_continuation_chain_splitting_is_exact(tmp_path):
+    """A continuation pass gives the same rows whatever the segment size and resume point."""
+    spec = sw.parse_spec(["gamma=0.09:0.2:6"], "down:steady,up")
+    plan = sw.make_plan(spec, set(), {})
+    rows: list[dict] = []
+    sw.run_serial(plan, SHORT, rows.extend)
+    ref = {r["key"]: r for r in rows}
+    seg_rows: list[dict] = []
+    for chain, state in plan.chains:
+        prev = ([], state)
+        for seg in sw.batches(chain, 4):
+            prev = sw.run_segment(seg, SHORT, prev)
+            seg_rows += prev[0]
+    _assert_identical(ref, {r["key"]: r for r in seg_rows})
+    done = {r["key"] for r in rows if r["index"] < 3}
+    states = {r["key"]: r["final_state"] for r in rows}
+    rest = sw.make_plan(spec, done, states)
+    assert rest.n_todo == 3 + 6  # "up" resumes at index 3; "down" has no finished prefix
+    more: list[dict] = []
+    sw.run_serial(rest, SHORT, more.extend)
+    for r in more:
+        _assert_identical({r["key"]: ref[r["key"]]}, {r["key"]: r})
+
+
+def test_dask_local_cluster_equals_serial(tmp_path):
+    """Two worker processes give the same numbers, point for point, as a serial run."""
+    starts = "rest,steady,large,up,down:steady" + (",cycle" if _cycles_available() else "")
+    spec = sw.parse_spec(["gamma=0.06:0.3:7", "mu=0.15"], starts)
+    sw.run_sweep(spec, SHORT, tmp_path / "serial", serial=True)
+    counts = sw.run_sweep(spec, SHORT, tmp_path / "dask", workers=2, batch=2, chunk=3,
+                          progress=False)
+    assert counts == {"total": 7 * len(spec.starts), "resumed": 0,
+                      "computed": 7 * len(spec.starts)}
+    a, b = _rows_by_key(tmp_path / "serial"), _rows_by_key(tmp_path / "dask")
+    assert len(a) == 7 * len(spec.starts)
+    _assert_identical(a, b)
+    regimes = {r["regime"] for r in a.values()}
+    assert {"free", "rub", "whip"} <= regimes
+
+
+def test_resume_refuses_a_different_sweep(tmp_path):
+    spec = sw.parse_spec(["gamma=0.1:0.2:2"], "steady")
+    sw.run_sweep(spec, SHORT, tmp_path / "o", serial=True)
+    with pytest.raises(sw.SweepError, match="holds a different sweep"):
+        sw.run_sweep(spec, sw.Settings(transient=61.0, record=30.0), tmp_path / "o",
+                     serial=True)
+    counts = sw.run_sweep(sw.parse_spec(["gamma=0.1:0.2:2"], "steady,rest"), SHORT,
+                          tmp_path / "o", serial=True)
+    assert counts == {"total": 4, "resumed": 2, "computed": 2}
+
+
+def test_resume_after_killed_cli_run(tmp_path):
+    """Kill the CLI (and its worker processes) after some rows, rerun: all rows, once, exact."""
+    out = tmp_path / "killed.parquet"
+    args = ["gamma=0.06:0.3:40", "--starts", "rest,up,down:steady", "--transient", "150",
+            "--record", "50", "--out", str(out)]
+    cmd = [sys.executable, "-m", "rotortd_tools.cli", "sweep", *args, "--workers", "2",
+           "--batch", "1", "--chunk", "2", "--flush-seconds", "0.3", "--no-progress"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and proc.poll() is None:
+            if len(sw.part_files(out)) >= 2:
+                break
+            time.sleep(0.05)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+    n_before = len(sw.read_sweep(out).get("key", []))
+    assert 0 < n_before < 120, "the run was not interrupted part way"
+    res = subprocess.run([sys.executable, "-m", "rotortd_tools.cli", "sweep", *args,
+                          "--workers", "2", "--no-progress"],
+                         capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    assert f"{n_before} already present" in res.stdout
+    spec = sw.parse_spec(["gamma=0.06:0.3:40"], "rest,up,down:steady")
+    settings = sw.Settings(transient=150.0, record=50.0)
+    sw.run_sweep(spec, settings, tmp_path / "ref", serial=True)
+    _assert_identical(_rows_by_key(tmp_path / "ref"), _rows_by_key(out))
+
+
+# --------------------------------------------------------------------------- plots
+
+
+def test_sweep_plot_1d_2d_and_chapter_events(tmp_path):
+    from rotortd_tools.sweep_plot import beb_values, chapter_events, gamma_beb
+
+    sw.run_sweep(sw.parse_spec(["gamma=0.06:0.2:4"], "rest,steady"), SHORT,
+                 tmp_path / "a", serial=True)
+    sw.run_sweep(sw.parse_spec(["gamma=0.06:0.2:3", "mu=0.1:0.3:2"], "rest"), SHORT,
+                 tmp_path / "b", serial=True)
+    res = tmp_path / "chapter_results.json"
+    res.write_text(json.dumps({"events": [{"event": "fold", "gamma": 0.15}],
+                               "gamma_grazing": 0.0651, "pd": [0.11], "other": 3}))
+    assert chapter_events(res) == [("grazing", 0.0651), ("period doubling", 0.11),
+                                   ("fold", 0.15)]
+    assert chapter_events(tmp_path / "missing.json") == []
+    g = gamma_beb({})
+    assert beb_values("gamma", 0.05, 0.3, {}) == pytest.approx([g], abs=1e-6)
+    assert g == pytest.approx(0.07285, abs=1e-5)
+    assert main(["sweep-plot", str(tmp_path / "a"), "-o", str(tmp_path / "a.png"),
+                 "--results", str(res)]) == 0
+    assert main(["sweep-plot", str(tmp_path / "b"), "-o", str(tmp_path / "b.png")]) == 0
+    assert (tmp_path / "a.png").stat().st_size > 10_000
+    assert (tmp_path / "b.png").stat().st_size > 10_000
+    assert main(["sweep-plot", str(tmp_path / "none"), "-o", str(tmp_path / "c.png")]) == 2
