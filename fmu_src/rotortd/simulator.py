@@ -517,7 +517,7 @@ class TouchdownCore:
         if vb * vb <= 2.0 * A * ETA_HEIGHT * p.c_r:
             return True
         v1 = math.sqrt(2.0 * A * ETA_HEIGHT * p.c_r)
-        if p.d < 1.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
+        if p.d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
             return False
         wf = self._wf
         assert wf is not None
