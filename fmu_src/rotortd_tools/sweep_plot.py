@@ -9,9 +9,10 @@ parameters scaled (Omega in rad/s). Analytic markers:
   located on a fine grid of the swept parameter (other parameters as in the sweep);
 - events of the period-one cycles (fold, period doubling, grazing, torus) read from a JSON
   file (``docs/chapter_results.json`` by default, when it exists): any object with a
-  numeric ``gamma`` and a string ``event``/``type``/``kind``/``name``, or any key naming an
-  event (``fold``, ``period_doubling``/``pd``, ``grazing``, ``torus``) with a number or a
-  list of numbers; used for gamma sweeps only.
+  numeric ``gamma`` and a string ``event``/``type``/``kind``/``name``, or any key that
+  names an event (``fold``, ``period_doubling``/``pd``, ``grazing``, ``torus``) and
+  contains ``gamma`` (or is the bare word), with a number or a list of numbers; events
+  under a ``rub`` key are labelled "rub ..."; used for gamma sweeps only.
 """
 
 from __future__ import annotations
@@ -119,20 +120,22 @@ def chapter_events(path: Path | None) -> list[tuple[str, float]]:
     return sorted(seen.values(), key=lambda e: e[1])
 
 
-def _walk_events(node: Any, key: str) -> Iterator[tuple[str, float]]:
-    label = _event_label(key)
+def _walk_events(node: Any, path: str) -> Iterator[tuple[str, float]]:
+    key = path.rsplit("/", 1)[-1].lower()
+    prefix = "rub " if "rub" in path.lower() else ""
+    label = _event_label(key) if ("gamma" in key or key in EVENT_WORDS) else ""
     if isinstance(node, dict):
         tag = next((node[k] for k in ("event", "type", "kind", "name")
                     if isinstance(node.get(k), str)), None)
         if tag and _event_label(tag) and _is_number(node.get("gamma")):
-            yield _event_label(tag), float(node["gamma"])
+            yield prefix + _event_label(tag), float(node["gamma"])
         for k, v in node.items():
-            yield from _walk_events(v, k)
+            yield from _walk_events(v, f"{path}/{k}")
     elif isinstance(node, list):
         for v in node:
-            yield from _walk_events(v, key)
+            yield from _walk_events(v, path)
     elif label and _is_number(node):
-        yield label, float(node)
+        yield prefix + label, float(node)
 
 
 def _event_label(text: str) -> str:
@@ -238,7 +241,7 @@ def _draw_markers(axes, name, lo, hi, fixed, events) -> None:
     marks = [("BEB", v) for v in beb_values(name, lo, hi, fixed)]
     marks += [(lab, g) for lab, g in events if lo <= g <= hi]
     styles = {"BEB": "k--", "fold": "g:", "period doubling": "b-.", "grazing": "r:",
-              "torus": "m:"}
+              "torus": "m:", "rub fold": "y:"}
     for lab, v in marks:
         for ax in axes:
             ax.axvline(v, color=styles.get(lab, "k:")[0], ls=styles.get(lab, "k:")[1:], lw=1)
@@ -259,19 +262,19 @@ def _regime_legend(ax, regimes: Sequence[str]) -> None:
 def regime_map(cols: dict[str, np.ndarray], names: list[str], fixed: dict[str, float]):
     """One regime map per start over the two swept parameters, BEB curve overlaid."""
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
     starts = list(dict.fromkeys(str(s) for s in cols["start"]))
-    ncol = min(3, len(starts))
+    ncol = 2 if len(starts) == 4 else min(3, len(starts))
     nrow = math.ceil(len(starts) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.6 * ncol + 1, 4.0 * nrow),
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.0 * ncol, 4.2 * nrow + 0.6),
                              squeeze=False, layout="constrained", sharex=True, sharey=True)
     x, y = cols[names[0]].astype(float), cols[names[1]].astype(float)
-    col = np.array(regime_colours(cols["regime"]))
-    size = _marker_size(x, y)
+    groups = np.array([regime_group(str(r)) for r in cols["regime"]])
     beb = _beb_curve(names, x, y, fixed)
     for ax, start in zip(axes.flat, starts):
         sel = cols["start"] == start
-        ax.scatter(x[sel], y[sel], c=col[sel], s=size, marker="s", lw=0)
+        _draw_cells(ax, x[sel], y[sel], groups[sel])
         if beb is not None:
             ax.contour(*beb, levels=[0.0], colors="k", linestyles="--", linewidths=1)
         ax.set_title(f"start: {start}")
@@ -279,9 +282,35 @@ def regime_map(cols: dict[str, np.ndarray], names: list[str], fixed: dict[str, f
         ax.set_ylabel(_label(names[1]))
     for ax in list(axes.flat)[len(starts):]:
         ax.set_visible(False)
-    _regime_legend(axes.flat[0], [str(r) for r in cols["regime"]])
+    present = set(groups)
+    handles = [Line2D([], [], ls="", marker="s", color=COLOURS[g], label=g)
+               for g in REGIMES if g in present]
+    fig.legend(handles=handles, loc="outside lower center", ncol=len(handles))
     fig.suptitle(f"regimes; dashed: BEB |U*| = 1; fixed: {_fixed_text(fixed)}")
     return fig
+
+
+def _draw_cells(ax, x: np.ndarray, y: np.ndarray, groups: np.ndarray) -> None:
+    """Regime cells: a mesh when the points form a full grid, else square markers."""
+    from matplotlib.colors import ListedColormap
+
+    xs, ys = np.unique(x), np.unique(y)
+    if len(x) == len(xs) * len(ys) and len(xs) > 1 and len(ys) > 1:
+        code = {g: k for k, g in enumerate(REGIMES)}
+        Z = np.full((len(ys), len(xs)), np.nan)
+        Z[np.searchsorted(ys, y), np.searchsorted(xs, x)] = [code[g] for g in groups]
+        cmap = ListedColormap([COLOURS[g] for g in REGIMES])
+        ax.pcolormesh(_edges(xs), _edges(ys), Z, cmap=cmap, vmin=-0.5,
+                      vmax=len(REGIMES) - 0.5)
+    else:
+        ax.scatter(x, y, c=[COLOURS.get(g, "magenta") for g in groups],
+                   s=_marker_size(x, y), marker="s", lw=0)
+
+
+def _edges(v: np.ndarray) -> np.ndarray:
+    """Cell edges around sorted centres v."""
+    mid = (v[1:] + v[:-1]) / 2.0
+    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
 
 
 def _marker_size(x: np.ndarray, y: np.ndarray) -> float:
