@@ -201,3 +201,17 @@ def test_step_split_independence_with_sustained_contact() -> None:
     for z, v in finals[1:]:
         assert abs(z - finals[0][0]) <= 1e-10 * p.c_r
         assert abs(v - finals[0][1]) <= 1e-10 * p.c_r * W0
+
+
+def test_spin_reversal_while_sliding_keeps_the_whirl() -> None:
+    """A host that changes Omega between steps changes the slip direction, not the whirl."""
+    p = BASE.replace(k=0.0, c=0.0, e_c=0.0, mu=0.01)
+    core = TouchdownCore(p, p.c_r, 1j * p.c_r * 100.0)  # on the wall, whirling at 100 rad/s
+    core.step(1e-4, W0)
+    assert core.mode == MODE_SLIDING
+    w_before = core.kinematics(W0).whirl_rate
+    rep = core.step(1e-5, -W0)  # slip reverses: friction now accelerates the whirl
+    w_after = core.kinematics(-W0).whirl_rate
+    assert rep.E_diss >= 0.0
+    assert abs(w_after - w_before) <= p.mu * (w_before**2) * 1e-5 * 1.01
+    assert w_after > w_before

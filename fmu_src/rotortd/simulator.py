@@ -566,8 +566,11 @@ class TouchdownCore:
         p = self._p
         rem = h - s
         E = self._phasor()
-        if self._mode == MODE_ROLLING and wf.wr + self._dtheta != 0.0:
-            self._choose_contact_mode()  # the spin changed: slip until it rolls again
+        vrel = wf.wr + self._dtheta
+        if (self._mode == MODE_ROLLING and vrel != 0.0) or (
+            self._mode == MODE_SLIDING and vrel * self._slip <= 0.0
+        ):
+            self._choose_contact_mode()  # the host changed Omega: the slip follows v_rel
         if self._leaves_wall(E):
             self._lift_off()
             return s
