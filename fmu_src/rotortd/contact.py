@@ -95,6 +95,14 @@ class WallForces:
         dP = (1j * self.Omega * self.eu * E - 1j * dtheta * Q) * w
         return dP.real + 2.0 * dtheta * ddtheta
 
+    def cone_margin(self, theta: float, dtheta: float, E: complex) -> tuple[float, float]:
+        """(mu Gn - |Gt|, its rate along rolling) in 1/s^2 and 1/s^3: rolling holds while > 0."""
+        gn, gt = self.gn_gt(theta, dtheta, E)
+        w = complex(math.cos(theta), -math.sin(theta))
+        dP = (1j * self.Omega * self.eu * E - 1j * dtheta * (self.q0 + self.eu * E)) * w
+        rate = self.mu * (dP.real) - math.copysign(1.0, gt) * dP.imag
+        return self.mu * gn - abs(gt), rate
+
     def gn_tol(self, dtheta: float) -> float:
         """Rounding band of Gn (1/s^2): inside it the sign of dGn/dt decides lift-off."""
         return (
@@ -245,10 +253,10 @@ class Sliding:
                 if fx > 0.0:
                     lo, flo = x, fx
                     break
-                if x == H * 2.0**-40:
-                    y_x, _ = at(x)
-                    return x, y_x, self._kind(y_x, u + x, s_n, s_v)
                 x *= 2.0
+            else:  # never off the surface: the event is immediate
+                y_x, _ = at(H * 2.0**-40)
+                return H * 2.0**-40, y_x, self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
         hi, y_best = H, y_hi
         side = 0
         for _ in range(100):
@@ -309,6 +317,11 @@ class TrigSum:
         M = abs(self.a1) * self.nu1**2 + abs(self.a2) * self.nu2**2
         tol = 1e-15 * (abs(self.C) + abs(self.a1) + abs(self.a2))
         u = 0.0
+        f0, df0 = self.value(0.0)
+        if f0 <= tol and df0 > 0.0 and M > 0.0:  # on the boundary, moving inside: step off
+            u = min(df0 / M, x_max)
+            if self.value(u)[0] <= tol:
+                return 0.0
         for _ in range(MAX_ROOT_ITERS):
             tally.work += 1
             f, df = self.value(u)

@@ -548,8 +548,11 @@ class TouchdownCore:
         if vrel != 0.0:
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, vrel)
             return
-        gn, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
-        if abs(gt) <= wf.mu * gn:
+        E = self._phasor()
+        _, gt = wf.gn_gt(self._theta, self._dtheta, E)
+        margin, rate = wf.cone_margin(self._theta, self._dtheta, E)
+        tol = wf.gn_tol(self._dtheta) * (1.0 + wf.mu)
+        if margin > tol or (margin >= -tol and rate > 0.0):  # inside the cone, or entering
             self._mode = MODE_ROLLING
         else:
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
