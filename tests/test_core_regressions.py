@@ -1,0 +1,71 @@
+"""Scenes that fuzzing once broke, kept as quick regression tests.
+
+Each ran into a state handed back and forth between two modes at one instant, or into
+an arithmetic corner; each must now finish every step within its work cap.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import pytest
+from rotortd import RotorParams, TouchdownCore
+
+CASES = {
+    # N crosses 0 while sliding: free flight saw 'pressing', contact saw 'pulling'
+    "lift-off tie at N = 0": (
+        dict(m=0.2275765295959083, c=0.0, k=0.0, e_c=1.0000000000000232e-09,
+             phi=-2.513698661651737, c_r=1e-09, R=1e-09, mu=1e-05, d=0.0, g=0.0,
+             levitate=False),
+        1.0000002744895709, 1 + 0j, 0j,
+        [(0.0003292534624965832, 0.0, 0.0, 0.9443905167400992), (1.0, 1.0, 0.0, 0.1796875)],
+    ),
+    # sliding restarted at exactly zero slip re-found the trivial event forever
+    "slip restart at v_rel = 0": (
+        dict(m=1.0, c=0.0, k=0.0, e_c=2.0625403481418077e-09, phi=3.0490926067571964,
+             c_r=1e-09, R=1.164531629654549e-09, mu=0.06149251206833829, d=0.0, g=0.0,
+             levitate=True),
+        9.965667595132976, 0j, 0.34473088621789405 + 0j,
+        [(0.0017557449382459415, 0.0, 0.0, 0.08588486635618021),
+         (0.9999997255105045, 0.37, 0.0, 4.25009999636114e-178),
+         (1.0, -1.0, 0.0, 0.5), (3.037068934499845e-07, 1.0, 0.0, 0.0)],
+    ),
+    # the friction-cone edge: rolling <-> sliding at one instant
+    "friction-cone edge": (
+        dict(m=0.5167296306383199, c=0.0, k=0.0, e_c=9.854135872901524e-14,
+             phi=1.5630597812840679e-21, c_r=1e-09, R=2.865243745654152e-09,
+             mu=1.3521222343271362, d=0.0, g=0.0, levitate=True),
+        4.549928114663448, 0j, 0.45142014239913425 - 0.1546026865902977j,
+        [(1.0, 0.37, 0.0, 1.7402647114261542),
+         (2.5963952828924218e-08, 1.0, 0.0, 1.4754989934842426),
+         (0.026707615582180808, 1.0, 0.0, 0.0)],
+    ),
+    # a denormal outward force made the low-speed rule divide by zero
+    "denormal outward force": (
+        dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,
+             levitate=False),
+        10.0, 0j, 1 + 0j, [(1.0, 1.0, 0.0, 5e-324)],
+    ),
+    # k = 2e-200: the steady offset f0/kappa overflowed in the envelope bound
+    "tiny stiffness": (
+        dict(m=1.0, c=0.0, k=1.9729346285183482e-200, e_c=0.0, phi=0.0, c_r=1e-09, R=1e-09,
+             mu=0.0, d=0.0, g=0.0, levitate=False),
+        1.0, 0j, 0j, [(1.0, 1.0, 1.0, 1.0), (1.0, 1.0, 1.0, 1.0)],
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_fuzz_regression(name: str) -> None:
+    par, W_ref, U0, dU0, steps = CASES[name]
+    p = RotorParams(**par)
+    core = TouchdownCore.from_scaled(p, W_ref, U0, dU0)
+    for h, w_scale, amb, f_scale in steps:
+        W = w_scale * W_ref
+        F = f_scale * p.m * p.c_r * W_ref**2 * cmath.exp(1.3j)
+        rep = core.step(h, W, F, amb)
+        assert rep.status == 0, rep.message
+        assert rep.work <= rep.work_cap
+        assert math.isfinite(core.z.real) and abs(core.z) <= p.c_r * (1 + 1e-12)
+        assert rep.E_diss >= 0.0
