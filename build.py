@@ -51,6 +51,8 @@ BASE_UNITS: dict[str, dict[str, int]] = {
     "N/m": {"kg": 1, "s": -2},
     "N.s/m": {"kg": 1, "s": -1},
     "J": {"kg": 1, "m": 2, "s": -2},
+    "kg.m2": {"kg": 1, "m": 2},
+    "N.m.s": {"kg": 1, "m": 2, "s": -1},
 }
 
 
@@ -101,14 +103,47 @@ E_diss = &sum; [&frac12; m (1&minus;d&sup2;) rdot&minus;&sup2; + P_t (v_rel&minu
 </ul>
 """
 
+DRIVE_EQUATIONS = """
+<h2>Equations</h2>
+<pre>J &Omega;' = T_motor &minus; b &Omega; + T_bearing,   &psi;' = &Omega;
+motor = 0: T_motor = T_motor_in
+motor = 1: u = Kp (&Omega;_set &minus; &Omega;) + Ki I,  I' = &Omega;_set &minus; &Omega;,
+           T_motor = u clipped to [&minus;T_max, T_max], I frozen while saturated</pre>
+<p>Inputs are held over a communication step; each regime is a linear ODE advanced in
+closed form and regime switches are located on the closed form, so a step is exact.
+H_motor + H_drag + H_bearing = J (&Omega; &minus; &Omega;0) to round-off.
+With follow_speed, &Omega; = Omega_in (held) and only the torques are computed.</p>
+"""
+
+EVENTS_EQUATIONS = """
+<h2>Schedule</h2>
+<pre>amb_on = amb_before (t &lt; t_fail), amb_after (t &ge; t_fail)
+F_x, F_y = F_x_step, F_y_step (t_force_on &le; t &lt; t_force_off), else 0</pre>
+<p>The outputs after doStep(t, h) are the values at t + h.</p>
+"""
+
 FMU_SPECS: tuple[FmuSpec, ...] = (
     FmuSpec(
         name="RotorTouchdown",
         script=Path("fmu_src/RotorTouchdown.py"),
-        project_dirs=(Path("fmu_src/rotortd"),),
+        project_dirs=(Path("fmu_src/rotortd"), Path("fmu_src/rotortd_drive")),
         options={"canHandleVariableCommunicationStepSize": True,
                  "canGetAndSetFMUstate": True, "canSerializeFMUstate": True},
         equations_html=ROTOR_EQUATIONS,
+    ),
+    FmuSpec(
+        name="Drivetrain",
+        script=Path("fmu_src/Drivetrain.py"),
+        project_dirs=(Path("fmu_src/rotortd_drive"),),
+        options={"canHandleVariableCommunicationStepSize": True,
+                 "canGetAndSetFMUstate": True, "canSerializeFMUstate": True},
+        equations_html=DRIVE_EQUATIONS,
+    ),
+    FmuSpec(
+        name="TouchdownEvents",
+        script=Path("fmu_src/TouchdownEvents.py"),
+        options={"canHandleVariableCommunicationStepSize": True},
+        equations_html=EVENTS_EQUATIONS,
     ),
 )
 

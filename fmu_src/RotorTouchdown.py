@@ -50,11 +50,14 @@ VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
     "vx0": ("m/s", None, None),
     "vy0": ("m/s", None, None),
     "psi0": ("rad", None, None),
+    "J": ("kg.m2", 0.0, None),
+    "h_spin": ("s", 0.0, None),
     # inputs
     "Omega": ("rad/s", None, None),
     "F_x": ("N", None, None),
     "F_y": ("N", None, None),
     "amb_on": ("1", 0.0, 1.0),
+    "T_drive": ("N.m", None, None),
     # outputs
     "x": ("m", None, None),
     "y": ("m", None, None),
@@ -79,6 +82,7 @@ VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
     "t_last_impact": ("s", None, None),
     "v_last_impact": ("m/s", 0.0, None),
     "E_diss": ("J", 0.0, None),
+    "Omega_out": ("rad/s", None, None),
     # Integer outputs (unit ignored for non-Real types by build.py)
     "mode": ("", 0, 2),
     "n_impacts": ("", 0, None),
@@ -102,6 +106,9 @@ REAL_PARAMETERS: tuple[tuple[str, float, str], ...] = (
     ("vx0", 0.0, "Initial velocity x [m/s], finite; ignored if start_steady"),
     ("vy0", 0.0, "Initial velocity y [m/s], finite; ignored if start_steady"),
     ("psi0", 0.0, "Initial spin angle [rad], finite"),
+    ("J", 0.04, "Polar inertia of the spin, used if integrate_spin [kg.m2], > 0"),
+    ("h_spin", 1e-6, "Largest internal sub-step of the spin integration, used if "
+                     "integrate_spin [s], > 0"),
 )
 TUNABLE: frozenset[str] = frozenset({"c", "k", "mu", "d", "e_c", "phi"})
 CORE_PARAMS: tuple[str, ...] = ("m", "c", "k", "e_c", "phi", "c_r", "R", "mu", "d", "g")
@@ -111,6 +118,8 @@ INPUTS: tuple[tuple[str, float, str], ...] = (
     ("F_x", 0.0, "External force on the rotor, x [N], finite"),
     ("F_y", 0.0, "External force on the rotor, y [N], finite"),
     ("amb_on", 1.0, "Magnetic bearing state: 1 on, 0 failed [1], in [0, 1]"),
+    ("T_drive", 0.0, "Drive torque on the spin (motor minus drag), used if integrate_spin "
+                     "[N.m], finite"),
 )
 
 REAL_OUTPUTS: tuple[tuple[str, str], ...] = (
@@ -137,6 +146,8 @@ REAL_OUTPUTS: tuple[tuple[str, str], ...] = (
     ("t_last_impact", "Time of the last impact [s]; 0 before any impact"),
     ("v_last_impact", "Normal speed rdot- of the last impact [m/s], >= 0; 0 before any"),
     ("E_diss", "Energy dissipated by contact, cumulative [J], >= 0"),
+    ("Omega_out", "Spin speed at the end of the step: the integrated spin if "
+                  "integrate_spin, else the input Omega [rad/s]"),
 )
 
 STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core-api.md)
@@ -187,6 +198,7 @@ class RotorTouchdown(Fmi2Slave):
         self._t0 = 0.0
         self._failure = ""          # non-empty: the model is unusable, do_step refuses
         self._fixed_snapshot: dict[str, Any] = {}
+        self._spin: Any = None      # rotortd_drive.SpinCoupler if integrate_spin
 
     # ------------------------------------------------------------------ declaration
     def _declare_parameters(self) -> None:
@@ -205,6 +217,13 @@ class RotorTouchdown(Fmi2Slave):
             variability=Fmi2Variability.fixed,
             description="Start on the steady free whirl (error if not admissible) [-]; "
                         "overrides x0, y0, vx0, vy0"))
+        self.integrate_spin = False
+        self.register_variable(Boolean(
+            "integrate_spin", causality=Fmi2Causality.parameter,
+            variability=Fmi2Variability.fixed,
+            description="Integrate the spin inside the FMU: J Omega' = T_drive + T_f, "
+                        "sub-stepped at h_spin; the input Omega is then only the initial "
+                        "speed and Omega_out the spin [-]"))
         self.impact_log = ""
         self.register_variable(String(
             "impact_log", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
@@ -292,10 +311,24 @@ class RotorTouchdown(Fmi2Slave):
             core = rotortd.TouchdownCore(params, z0=z0, v0=complex(float(self.vx0),
                                          float(self.vy0)), psi0=float(self.psi0), t0=self._t0)
         self._core = core
+        self._spin = self._make_spin(omega)
+        self.Omega_out = omega
         self._fixed_snapshot = self._fixed_values()
         self._publish_kinematics(omega, amb)
         self._publish_counters()
         self._publish_step_outputs(None, 0)
+
+    def _make_spin(self, omega: float) -> Any:
+        """The spin integrator (integrate_spin) or None."""
+        if not self.integrate_spin:
+            return None
+        from rotortd_drive import SpinCoupler  # resources/rotortd_drive inside the FMU
+
+        for name in ("J", "h_spin"):
+            if not float(getattr(self, name)) > 0.0:
+                raise ModelError(f"{name}={getattr(self, name)!r} must be > 0 "
+                                 f"with integrate_spin")
+        return SpinCoupler(float(self.J), float(self.h_spin), omega)
 
     def _make_params(self, rotortd: Any) -> Any:
         kwargs = {name: float(getattr(self, name)) for name in CORE_PARAMS}
@@ -303,7 +336,7 @@ class RotorTouchdown(Fmi2Slave):
 
     def _fixed_values(self) -> dict[str, Any]:
         names = [n for n, _s, _d in REAL_PARAMETERS if n not in TUNABLE]
-        names += ["levitate", "start_steady", "impact_log"]
+        names += ["levitate", "start_steady", "impact_log", "integrate_spin"]
         return {n: getattr(self, n) for n in names}
 
     # ------------------------------------------------------------------ stepping
@@ -345,7 +378,13 @@ class RotorTouchdown(Fmi2Slave):
                              f"model time {self._core.t!r}")
         omega, f_ext, amb = self._input_values()
         t_target = self._core.t + step_size
-        rep = self._core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
+        if self._spin is not None:
+            rep = self._spin.step(self._core, step_size, float(self.T_drive), F_ext=f_ext,
+                                  amb_on=amb)
+            omega = self._spin.Omega
+        else:
+            rep = self._core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
+        self.Omega_out = omega
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         self._publish_kinematics(omega, amb)
@@ -419,7 +458,8 @@ class RotorTouchdown(Fmi2Slave):
                 "variables": values,
                 "core": None if self._core is None else self._core.get_state(),
                 "adapter": {"t0": self._t0, "failure": self._failure,
-                            "fixed_snapshot": self._fixed_snapshot},
+                            "fixed_snapshot": self._fixed_snapshot,
+                            "spin": None if self._spin is None else self._spin.Omega},
             }
             # JSON round trip: an independent deep copy, and proof that it serialises.
             return json.loads(json.dumps(state))
@@ -457,6 +497,8 @@ class RotorTouchdown(Fmi2Slave):
         self._t0 = float(adapter["t0"])
         self._failure = str(adapter["failure"])
         self._fixed_snapshot = dict(adapter["fixed_snapshot"])
+        spin = adapter.get("spin")
+        self._spin = None if spin is None else self._make_spin(float(spin))
 
     def _new_core_for_restore(self) -> Any:
         import rotortd

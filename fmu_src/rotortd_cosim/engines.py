@@ -1,0 +1,203 @@
+"""Run a scene's SSP on one engine; every runner returns {column: numpy array}.
+
+Columns: ``time`` (s, the communication point at the END of the step the values belong
+to) and ``Component.variable`` for every recorded output (scenes.RECORDED). Each runner
+loads PythonFMU FMUs into the calling process: run them in a subprocess
+(``python -m rotortd_cosim.run``), never in a test process.
+
+Engine differences handled here (see docs/cosimulation.md):
+- FMPy ``simulate_ssp`` ignores the SSP's parameter bindings: the scene's values are passed
+  as its ``parameter_set`` (names ``Component.var``, Python-typed: FMPy sets a Boolean as
+  ``value != 0.0``, so the SSV text "false" would become true). It labels each row with the
+  step's START time although the values are those after the step: shifted here by +h.
+  Its connectors all start at 0.0, so in the first step the bearing sees Omega = 0,
+  amb_on = 0, F = 0 whatever the upstream outputs are.
+- libcosim counts time in integer nanoseconds: the step is passed as round(h * 1e9).
+- ecos: the bundled binaries need chmod +x; the native CLI needs LD_PRELOAD of libpython.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import shutil
+import stat
+import subprocess
+import sysconfig
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .scenes import RECORDED, SCENES, Scene
+
+Result = dict[str, np.ndarray]
+COLUMNS = [f"{c}.{v}" for c, v in RECORDED]
+
+
+def _steps(scene: Scene, step: float, stop: float | None) -> tuple[int, float]:
+    stop_time = scene.stop_time if stop is None else stop
+    return round(stop_time / step), stop_time
+
+
+# ---------------------------------------------------------------------------- FMPy SSP
+def fmpy_parameter_set(scene: Scene) -> Any:
+    """The scene's start values as an FMPy ParameterSet (prefixed, Python-typed)."""
+    from fmpy.ssp.ssd import Parameter, ParameterSet
+
+    pset = ParameterSet(name=scene.name)
+    for comp, values in scene.components().items():
+        for name, value in values.items():
+            par = Parameter(name=f"{comp}.{name}")
+            par.value = value
+            pset.parameters.append(par)
+    return pset
+
+
+def run_fmpy_ssp(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
+    """FMPy's fixed-step Jacobi SSP master."""
+    from fmpy.ssp.simulation import simulate_ssp
+
+    _n, stop_time = _steps(scene, step, stop)
+    res = simulate_ssp(str(ssp), stop_time=stop_time - 0.5 * step, step_size=step,
+                       parameter_set=fmpy_parameter_set(scene))
+    out: Result = {"time": np.asarray(res["time"], float) + step}
+    for col in COLUMNS:
+        out[col] = np.asarray(res[col], float)
+    return out
+
+
+# ---------------------------------------------------------------------------- libcosim
+def run_libcosim(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
+    """libcosimpy (Open Simulation Platform) from the SSP; times in integer ns."""
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimObserver import CosimObserver
+
+    n, _ = _steps(scene, step, stop)
+    step_ns = round(step * 1e9)
+    if step_ns <= 0 or abs(step_ns - step * 1e9) > 1e-6 * step * 1e9:
+        raise ValueError(f"step {step!r} s is not a whole number of nanoseconds")
+    ex = CosimExecution.from_ssp_file(str(ssp), step_size=step_ns)
+    obs = CosimObserver.create_last_value()
+    ex.add_observer(obs)
+    index, refs = _libcosim_refs(ex)
+    rows: dict[str, list[float]] = {c: [] for c in ["time", *COLUMNS]}
+    for k in range(n):
+        ex.step(1)
+        rows["time"].append((k + 1) * step_ns * 1e-9)
+        for col in COLUMNS:
+            comp, _var = col.split(".")
+            vref, kind = refs[col]
+            if kind == CosimVariableType.INTEGER.value:
+                val = obs.last_integer_values(index[comp], [vref])[0]
+            else:
+                val = obs.last_real_values(index[comp], [vref])[0]
+            rows[col].append(float(val))
+    ex.stop()
+    return {k: np.asarray(v, float) for k, v in rows.items()}
+
+
+def _libcosim_refs(ex: Any) -> tuple[dict[str, int], dict[str, tuple[int, int]]]:
+    index = {c: ex.slave_index_from_instance_name(c) for c, _ in RECORDED}
+    refs: dict[str, tuple[int, int]] = {}
+    for comp, idx in index.items():
+        for var in ex.slave_variables(idx):
+            name = var.name.decode() if isinstance(var.name, bytes) else var.name
+            if f"{comp}.{name}" in COLUMNS:
+                refs[f"{comp}.{name}"] = (var.reference, var.type)
+    return index, refs
+
+
+# ---------------------------------------------------------------------------- ecos
+def ecos_binaries() -> Path:
+    """The ecospy binaries folder, with the executables made executable (chmod +x)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("ecospy")
+    assert spec is not None and spec.origin is not None
+    folder = Path(spec.origin).parent / "binaries"
+    for exe in ("ecos", "proxyfmu"):
+        path = folder / exe
+        if path.exists() and not os.access(path, os.X_OK):
+            path.chmod(path.stat().st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
+    return folder
+
+
+def run_ecospy(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
+    """ecospy (Python binding of ecos) from the SSP."""
+    ecos_binaries()
+    from ecospy import EcosSimulation
+
+    n, _ = _steps(scene, step, stop)
+    rows: dict[str, list[float]] = {c: [] for c in ["time", *COLUMNS]}
+    with EcosSimulation(ssp_path=str(ssp), step_size=step) as sim:
+        sim.init(parameter_set=scene.name)
+        for k in range(n):
+            sim.step(1)
+            rows["time"].append((k + 1) * step)
+            for col in COLUMNS:
+                comp, var = col.split(".")
+                ident = f"{comp}::{var}"
+                val = sim.get_integer(ident) if var in ("mode", "n_impacts") \
+                    else sim.get_real(ident)
+                rows[col].append(float(val))
+        sim.terminate()
+    return {k: np.asarray(v, float) for k, v in rows.items()}
+
+
+def libpython() -> str:
+    """Path of the shared libpython of this interpreter (for LD_PRELOAD)."""
+    libdir = sysconfig.get_config_var("LIBDIR")
+    name = sysconfig.get_config_var("LDLIBRARY")
+    return str(Path(libdir) / name)
+
+
+def ecos_cli_command(ssp: Path, scene: Scene, step: float, stop: float) -> list[str]:
+    """The native ecos command line for a scene (see docs/cosimulation.md); it writes
+    <ssp stem>.csv with every variable into the working directory."""
+    exe = ecos_binaries() / "ecos"
+    return [str(exe), "simulate", "--path", str(ssp), "--stopTime", repr(stop),
+            "--stepSize", repr(step), "--parameterSet", scene.name]
+
+
+def run_ecos_cli(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
+    """The native ecos CLI; needs LD_PRELOAD of libpython for the PythonFMU FMUs."""
+    n, _ = _steps(scene, step, stop)
+    work = Path(tempfile.mkdtemp(prefix="rotortd_ecos_"))
+    try:
+        env = dict(os.environ, LD_PRELOAD=libpython())
+        cmd = ecos_cli_command(ssp.resolve(), scene, step, n * step)
+        proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
+                              timeout=1800)
+        path = work / f"{ssp.stem}.csv"
+        if proc.returncode != 0 or not path.exists():
+            raise RuntimeError(f"ecos failed ({proc.returncode}): {proc.stdout[-2000:]}"
+                               f"{proc.stderr[-2000:]}")
+        return _read_ecos_csv(path)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _read_ecos_csv(path: Path) -> Result:
+    """The recorded columns of an ecos CSV (header 'Comp::var[TYPE]'), without the row of
+    the initial values at t = 0."""
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    head = [h.strip().split("[")[0].replace("::", ".") for h in rows[0]]
+    wanted = {"time": head.index("time")}
+    wanted.update({c: head.index(c) for c in COLUMNS})
+    body = [r for r in rows[1:] if r and float(r[wanted["time"]]) > 0.0]
+    return {k: np.array([float(r[i]) for r in body]) for k, i in wanted.items()}
+
+
+ENGINES = {"fmpy": run_fmpy_ssp, "libcosim": run_libcosim, "ecospy": run_ecospy,
+           "ecos": run_ecos_cli}
+
+
+def run(engine: str, scene: str, ssp: Path, step: float | None = None,
+        stop: float | None = None) -> Result:
+    """Run a scene on an engine."""
+    sc = SCENES[scene]
+    return ENGINES[engine](ssp, sc, sc.step if step is None else step, stop)

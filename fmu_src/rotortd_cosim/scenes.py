@@ -1,0 +1,82 @@
+"""The three co-simulation scenes: parameters per component, stop time, step (SI units)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+OMEGA_RUN = 184.2          # rad/s, the chapter's speed
+T_FAIL = 0.1               # s, bearing failure in the drop test
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A system scene: start values per component (parameters and unconnected inputs)."""
+
+    name: str
+    title: str
+    stop_time: float                        # s
+    step: float                             # s, default communication step
+    rotor: dict[str, Any] = field(default_factory=dict)
+    drive: dict[str, Any] = field(default_factory=dict)
+    events: dict[str, Any] = field(default_factory=dict)
+
+    def components(self) -> dict[str, dict[str, Any]]:
+        """Start values by component instance name."""
+        return {"RotorTouchdown": self.rotor, "Drivetrain": self.drive,
+                "TouchdownEvents": self.events}
+
+
+DROP = Scene(
+    name="drop", title="Bearing failure at speed (drop test)", stop_time=0.35, step=1e-4,
+    rotor={"g": 9.81, "levitate": True, "start_steady": True, "Omega": OMEGA_RUN},
+    drive={"J": 0.04, "b": 1e-4, "motor": 1, "Omega0": OMEGA_RUN, "Omega_set": OMEGA_RUN,
+           "Kp": 0.2, "Ki": 2.0, "T_max": 5.0},
+    events={"t_fail": T_FAIL, "amb_before": 1.0, "amb_after": 0.0},
+)
+
+RUNDOWN = Scene(
+    name="rundown", title="Run-down through the critical speed sqrt(k/m) = 140 rad/s",
+    stop_time=0.6, step=1e-4,
+    rotor={"g": 9.81, "levitate": True, "start_steady": True, "Omega": 220.0},
+    drive={"J": 0.04, "b": 0.06, "motor": 0, "Omega0": 220.0, "T_motor_in": 0.0},
+    events={},
+)
+
+FORCE = Scene(
+    name="force", title="External force step pushes the rotor into the bearing",
+    stop_time=0.4, step=1e-4,
+    rotor={"g": 9.81, "levitate": True, "start_steady": True, "Omega": OMEGA_RUN,
+           "e_c": 0.15e-3, "c": 3000.0},
+    drive={"J": 0.04, "b": 1e-4, "motor": 1, "Omega0": OMEGA_RUN, "Omega_set": OMEGA_RUN,
+           "Kp": 0.2, "Ki": 2.0, "T_max": 5.0},
+    events={"t_force_on": 0.03, "t_force_off": 0.1, "F_y_step": -1500.0},
+)
+
+SCENES: dict[str, Scene] = {s.name: s for s in (DROP, RUNDOWN, FORCE)}
+
+# component-to-component connections (start component, output, end component, input)
+CONNECTIONS: tuple[tuple[str, str, str, str], ...] = (
+    ("Drivetrain", "Omega", "RotorTouchdown", "Omega"),
+    ("RotorTouchdown", "T_f", "Drivetrain", "T_bearing"),
+    ("TouchdownEvents", "amb_on", "RotorTouchdown", "amb_on"),
+    ("TouchdownEvents", "F_x", "RotorTouchdown", "F_x"),
+    ("TouchdownEvents", "F_y", "RotorTouchdown", "F_y"),
+)
+
+# outputs recorded by every engine (component, variable)
+RECORDED: tuple[tuple[str, str], ...] = (
+    ("Drivetrain", "Omega"), ("Drivetrain", "H_bearing"), ("Drivetrain", "H_motor"),
+    ("Drivetrain", "H_drag"), ("Drivetrain", "T_motor"),
+    ("RotorTouchdown", "T_f"), ("RotorTouchdown", "x"), ("RotorTouchdown", "y"),
+    ("RotorTouchdown", "vx"), ("RotorTouchdown", "vy"), ("RotorTouchdown", "r_rel"),
+    ("RotorTouchdown", "F_bx"), ("RotorTouchdown", "F_by"), ("RotorTouchdown", "F_n"),
+    ("RotorTouchdown", "mode"), ("RotorTouchdown", "n_impacts"),
+    ("RotorTouchdown", "t_last_impact"), ("RotorTouchdown", "v_last_impact"),
+    ("RotorTouchdown", "Omega_out"), ("RotorTouchdown", "psi"),
+    ("TouchdownEvents", "amb_on"),
+)
+
+FMU_FILES: dict[str, str] = {"RotorTouchdown": "RotorTouchdown.fmu",
+                             "Drivetrain": "Drivetrain.fmu",
+                             "TouchdownEvents": "TouchdownEvents.fmu"}

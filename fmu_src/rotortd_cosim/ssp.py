@@ -1,0 +1,135 @@
+"""Write the SSP (System Structure and Parameterization) files of the scenes.
+
+Each scene gives ``models/systems/<scene>.ssp``: a zip with ``SystemStructure.ssd`` and the
+three FMUs under ``resources/``. Components are connected component to component only (no
+system-level connectors: FMPy's SSP master crashes on an unconnected one) and every
+connection names ``startElement`` and ``endElement`` (libcosim needs both). The start values
+of each component sit in an inline ``ssd:ParameterBindings/ssd:ParameterValues`` parameter
+set named after the scene, with variable names unprefixed: libcosim and ecos apply it
+themselves; FMPy's ``simulate_ssp`` ignores bindings, so :mod:`.engines` passes the same
+values through its ``parameter_set`` argument (prefixed ``Component.name``).
+
+    python -m rotortd_cosim.ssp [--models models] [--out models/systems]
+"""
+
+from __future__ import annotations
+
+import argparse
+import zipfile
+from pathlib import Path
+from typing import Any
+from xml.sax.saxutils import quoteattr
+
+from .scenes import CONNECTIONS, FMU_FILES, RECORDED, SCENES, Scene
+
+NS = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
+      'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
+      'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"')
+INTEGER_VARS = frozenset({"mode", "n_impacts", "n_impacts_step", "motor", "pi_regime"})
+BOOLEAN_VARS = frozenset({"levitate", "start_steady", "integrate_spin", "follow_speed",
+                          "in_contact"})
+
+
+def ssv_type(name: str, value: Any) -> tuple[str, str]:
+    """SSV element name and value text for a start value."""
+    if name in BOOLEAN_VARS:
+        return "Boolean", "true" if value else "false"
+    if name in INTEGER_VARS:
+        return "Integer", str(int(value))
+    return "Real", repr(float(value))
+
+
+def connectors(component: str) -> list[tuple[str, str]]:
+    """(name, kind) of the connectors a component needs: connected and recorded ones."""
+    found: dict[str, str] = {}
+    for a, out, b, inp in CONNECTIONS:
+        if a == component:
+            found[out] = "output"
+        if b == component:
+            found[inp] = "input"
+    for comp, var in RECORDED:
+        if comp == component:
+            found.setdefault(var, "output")
+    return list(found.items())
+
+
+def _component_xml(name: str, values: dict[str, Any], scene: str) -> str:
+    conns = "\n".join(
+        f'          <ssd:Connector name="{c}" kind="{k}"><ssc:{ssv_type(c, 0)[0]}/>'
+        f"</ssd:Connector>" for c, k in connectors(name))
+    params = "\n".join(
+        f'                <ssv:Parameter name="{p}"><ssv:{t} value={quoteattr(v)}/>'
+        f"</ssv:Parameter>" for p, (t, v) in ((p, ssv_type(p, x)) for p, x in values.items()))
+    binding = ""
+    if values:
+        binding = f"""
+        <ssd:ParameterBindings>
+          <ssd:ParameterBinding>
+            <ssd:ParameterValues>
+              <ssv:ParameterSet version="1.0" name="{scene}">
+                <ssv:Parameters>
+{params}
+                </ssv:Parameters>
+              </ssv:ParameterSet>
+            </ssd:ParameterValues>
+          </ssd:ParameterBinding>
+        </ssd:ParameterBindings>"""
+    return f"""      <ssd:Component name="{name}" type="application/x-fmu-sharedlibrary" \
+source="resources/{FMU_FILES[name]}">
+        <ssd:Connectors>
+{conns}
+        </ssd:Connectors>{binding}
+      </ssd:Component>"""
+
+
+def ssd_text(scene: Scene) -> str:
+    """SystemStructure.ssd of a scene."""
+    comps = "\n".join(_component_xml(n, v, scene.name) for n, v in scene.components().items())
+    conns = "\n".join(
+        f'      <ssd:Connection startElement="{a}" startConnector="{o}" endElement="{b}" '
+        f'endConnector="{i}"/>' for a, o, b, i in CONNECTIONS)
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription {NS} version="1.0" name="{scene.name}">
+  <ssd:System name="{scene.name}" description={quoteattr(scene.title)}>
+    <ssd:Elements>
+{comps}
+    </ssd:Elements>
+    <ssd:Connections>
+{conns}
+    </ssd:Connections>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0.0" stopTime="{scene.stop_time!r}"/>
+</ssd:SystemStructureDescription>
+"""
+
+
+def write_ssp(scene: Scene, models: Path, out_dir: Path) -> Path:
+    """Write <out_dir>/<scene>.ssp (FMUs taken from models/) and <out_dir>/<scene>.ssd."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    text = ssd_text(scene)
+    (out_dir / f"{scene.name}.ssd").write_text(text, encoding="utf-8")
+    path = out_dir / f"{scene.name}.ssp"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr("SystemStructure.ssd", text)
+        for fmu in FMU_FILES.values():
+            zf.write(models / fmu, f"resources/{fmu}")
+    return path
+
+
+def write_all(models: Path, out_dir: Path) -> list[Path]:
+    """All scenes' SSP files."""
+    return [write_ssp(s, models, out_dir) for s in SCENES.values()]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description="write models/systems/<scene>.ssp")
+    parser.add_argument("--models", type=Path, default=Path("models"))
+    parser.add_argument("--out", type=Path, default=Path("models/systems"))
+    args = parser.parse_args(argv)
+    for path in write_all(args.models, args.out):
+        print(f"ssp: wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
