@@ -168,14 +168,16 @@ def run_ecos_cli(ssp: Path, scene: Scene, step: float, stop: float | None = None
     work = Path(tempfile.mkdtemp(prefix="rotortd_ecos_"))
     try:
         env = dict(os.environ, LD_PRELOAD=libpython())
-        cmd = ecos_cli_command(ssp.resolve(), scene, step, n * step)
+        # ecos accumulates t += h in floating point and stops before a stop time it
+        # would overshoot by round-off: ask for half a step more, keep n rows
+        cmd = ecos_cli_command(ssp.resolve(), scene, step, (n + 0.5) * step)
         proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
                               timeout=1800)
         path = work / f"{ssp.stem}.csv"
         if proc.returncode != 0 or not path.exists():
             raise RuntimeError(f"ecos failed ({proc.returncode}): {proc.stdout[-2000:]}"
                                f"{proc.stderr[-2000:]}")
-        return _read_ecos_csv(path)
+        return {k: v[:n] for k, v in _read_ecos_csv(path).items()}
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
