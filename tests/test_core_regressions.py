@@ -41,6 +41,13 @@ CASES = {
          (2.5963952828924218e-08, 1.0, 0.0, 1.4754989934842426),
          (0.026707615582180808, 1.0, 0.0, 0.0)],
     ),
+    # stick at the slip surface: the bracket started inside the rounding band of v_rel
+    "slip surface rounding band": (
+        dict(m=1.0, c=0.0, k=0.0, e_c=1.19708503049573e-09, phi=0.0, c_r=1e-09, R=1e-09,
+             mu=0.765625, d=0.0, g=0.0, levitate=False),
+        1.0, 0j, -0.6219247142870152 + 0.32801587672552446j,
+        [(1.0, 0.0, 0.0, 1.6875), (1.0, 1.0, 0.0, 1.25)],
+    ),
     # a denormal outward force made the low-speed rule divide by zero
     "denormal outward force": (
         dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,

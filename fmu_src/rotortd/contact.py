@@ -243,14 +243,15 @@ class Sliding:
             gn, sv = self.events(yx, u + x)
             return yx, min(gn / s_n, sv / s_v)
 
+        noise = 64.0 * 2.220446049250313e-16  # rounding band of the normalised events
         y_hi, fhi = at(H)
         gn0, sv0 = self.events(y, u)
         lo, flo = 0.0, min(gn0 / s_n, sv0 / s_v)
-        if flo <= 0.0:  # starting on the event surface: step off it first
+        if flo <= noise:  # starting on the event surface: step clearly off it first
             x = H * 2.0**-40
             while x < H:
                 _, fx = at(x)
-                if fx > 0.0:
+                if fx > noise:
                     lo, flo = x, fx
                     break
                 x *= 2.0
@@ -266,7 +267,7 @@ class Sliding:
             if not lo < x < hi:
                 x = 0.5 * (lo + hi)
             yx, fx = at(x)
-            if fx > 0.0:
+            if fx > noise:
                 lo, flo = x, fx
                 if side == -1:
                     fhi *= 0.5

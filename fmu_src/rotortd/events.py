@@ -267,7 +267,11 @@ class ContactLocator:
             return self._polish(s, z, v, E, g, g1, work)
         if g1 < -tol_g1:
             return None
-        tol_g2 = 64.0 * EPS * (abs(v) ** 2 + self.fm.c_r * abs(self.fm.accel(z, v, E)))
+        # rounding band of g'' = 2 c_r^2 Gn, four times wider than the contact side's band
+        # of Gn (WallForces.gn_tol), so a state is never 'pressing' here and 'leaving' there
+        fm = self.fm
+        force = abs(fm.f0) + abs(fm.F1) + fm.kappa * fm.c_r + fm.beta * abs(v)
+        tol_g2 = 256.0 * EPS * (abs(v) ** 2 + fm.c_r * force)
         if g2 > tol_g2 or (g2 >= -tol_g2 and self.g3(z, v, E) > 0.0):
             return Contact(s, z, v, E, "touch")
         return None
