@@ -48,6 +48,13 @@ CASES = {
         1.0, 0j, -0.6219247142870152 + 0.32801587672552446j,
         [(1.0, 0.0, 0.0, 1.6875), (1.0, 1.0, 0.0, 1.25)],
     ),
+    # a Coulomb-friction pendulum at the bottom: the extrapolation stayed at order 6 and
+    # crawled with 1e-4 s steps until the segment's step cap
+    "friction pendulum crawl": (
+        dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=0.0007, R=0.007, mu=1.625, d=0.0,
+             g=9.81, levitate=False),
+        1.0, 0j, 0j, [(10**-0.5, 1.0, 0.0, 0.0), (10**-0.5, 1.0, 0.0, 0.0)],
+    ),
     # a denormal outward force made the low-speed rule divide by zero
     "denormal outward force": (
         dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,

@@ -34,8 +34,11 @@ from .params import RotorParams
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""
+K_MIN = 5
+"""Fewest extrapolation columns before a step may be accepted (order >= 10). Accepting at
+lower order lets the step-size controller settle on needlessly short steps."""
 MAX_STEPS = 2000
-"""Cap on integrator steps in one sliding segment, plus 10 per maximal step in it."""
+"""Cap on integrator steps in one sliding segment, plus 50 per maximal step in it."""
 MAX_ROOT_ITERS = 200
 """Cap on conservative-advancement iterations for one rolling exit search."""
 
@@ -193,12 +196,14 @@ class Sliding:
         H = min(H0, self.h_max)
         tally = ContactTally()
         tally.peak = max(0.0, self.events(y, 0.0)[0])
-        for _ in range(MAX_STEPS + int(min(10.0 * rem / self.h_max, 1e9))):
+        for _ in range(MAX_STEPS + int(min(50.0 * rem / self.h_max, 1e9))):
             if u >= rem:
                 break
             step = min(H, rem - u)
             f0 = self.rhs(u, y)
-            y_new, err, k, nfev = gbs.extrapolated_step(self.rhs, u, y, f0, step, self.scale)
+            y_new, err, k, nfev = gbs.extrapolated_step(
+                self.rhs, u, y, f0, step, self.scale, k_min=K_MIN
+            )
             tally.work += nfev
             if err > 1.0:
                 H = gbs.next_step_size(step, err, k)
