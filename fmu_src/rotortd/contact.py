@@ -44,7 +44,11 @@ MAX_ROOT_ITERS = 200
 
 
 class ContactWorkExceeded(RuntimeError):
-    """A contact segment hit its work cap."""
+    """A contact segment hit its work cap; ``work`` is what it had used."""
+
+    def __init__(self, message: str, work: int = 0) -> None:
+        super().__init__(message)
+        self.work = work
 
 
 def wrap_angle(x: float) -> float:
@@ -218,7 +222,7 @@ class Sliding:
             u, y = u_next, y_new
             H = min(gbs.next_step_size(step, err, k), self.h_max)
         else:
-            raise ContactWorkExceeded("sliding segment exceeded its step cap")
+            raise ContactWorkExceeded("sliding segment exceeded its step cap", tally.work)
         self._tally(tally, y)
         return SegmentEnd(rem, y[0], y[1], None, tally), H
 
@@ -340,7 +344,9 @@ class TrigSum:
             if u + x >= x_max:
                 return None
             u += x
-        raise ContactWorkExceeded(f"rolling exit search exceeded {MAX_ROOT_ITERS} iterations")
+        raise ContactWorkExceeded(
+            f"rolling exit search exceeded {MAX_ROOT_ITERS} iterations", tally.work
+        )
 
 
 class Rolling:

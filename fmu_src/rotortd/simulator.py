@@ -392,6 +392,7 @@ class TouchdownCore:
                     tally.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
         except (WorkCapExceeded, SearchExhausted, ContactWorkExceeded) as exc:
             rep.status, rep.message = STATUS_WORK_CAP, f"t = {t0 + s!r} s: {exc}"
+            work.iters += getattr(exc, "work", 0)
         self._tick(h if s >= h else s)
         self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
         return rep
