@@ -191,6 +191,8 @@ class Sliding:
         """(Gn, s v_rel/c_r) at state y and local time u: contact ends when either is <= 0."""
         E = self.E0 * cmath.exp(1j * self.wf.Omega * u)
         gn, _ = self.wf.gn_gt(y[0], y[1], E)
+        if self.wf.mu == 0.0:  # frictionless: the slip direction carries no physics
+            return gn, 1.0
         return gn, self.s * (self.wf.wr + y[1])
 
     def run(self, rem: float, H0: float) -> tuple[SegmentEnd, float]:

@@ -546,7 +546,7 @@ class TouchdownCore:
         wf = self._wf
         assert wf is not None
         vrel = wf.wr + self._dtheta
-        if vrel != 0.0:
+        if vrel != 0.0 or wf.mu == 0.0:  # frictionless contact always 'slides'
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, vrel)
             return
         E = self._phasor()
@@ -572,7 +572,7 @@ class TouchdownCore:
         E = self._phasor()
         vrel = wf.wr + self._dtheta
         if (self._mode == MODE_ROLLING and vrel != 0.0) or (
-            self._mode == MODE_SLIDING and vrel * self._slip <= 0.0
+            self._mode == MODE_SLIDING and vrel * self._slip <= 0.0 and wf.mu != 0.0
         ):
             self._choose_contact_mode()  # the host changed Omega: the slip follows v_rel
         if self._leaves_wall(E):
