@@ -154,7 +154,7 @@ class SegmentEnd:
     du: float
     theta: float
     dtheta: float
-    event: str | None  # None (reached the end), "lift_off", "slip_zero", "cone"
+    event: str | None  # None (end), "lift_off", "slip_zero", "slip_stuck", "cone"
     tally: ContactTally = field(default_factory=ContactTally)
 
 
@@ -268,7 +268,9 @@ class Sliding:
                 x *= 2.0
             else:  # never off the surface: the event is immediate
                 y_x, _ = at(H * 2.0**-40)
-                return H * 2.0**-40, y_x, self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
+                kind = self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
+                stuck = kind == "slip_zero" and abs(sv0) <= noise * s_v
+                return H * 2.0**-40, y_x, "slip_stuck" if stuck else kind
         hi, y_best = H, y_hi
         side = 0
         for _ in range(100):

@@ -553,7 +553,8 @@ class TouchdownCore:
         _, gt = wf.gn_gt(self._theta, self._dtheta, E)
         margin, rate = wf.cone_margin(self._theta, self._dtheta, E)
         tol = wf.gn_tol(self._dtheta) * (1.0 + wf.mu)
-        if margin > tol or (margin >= -tol and rate > 0.0):  # inside the cone, or entering
+        # inside the cone, entering it, or on its edge with no tendency to leave: roll
+        if margin > tol or (margin >= -tol and rate > 0.0) or (margin >= 0.0 and rate == 0.0):
             self._mode = MODE_ROLLING
         else:
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
@@ -619,6 +620,10 @@ class TouchdownCore:
         elif event == "slip_zero":
             self._dtheta = -wf.wr
             self._choose_contact_mode()
+            self._locked = False
+        elif event == "slip_stuck":  # sliding cannot leave zero slip: it rolls
+            self._dtheta = -wf.wr
+            self._mode = MODE_ROLLING
             self._locked = False
         elif event == "cone":
             _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
