@@ -387,12 +387,18 @@ class Rolling:
         X = self.A1 * cmath.exp(1j * self.nu1 * u) + self.A2 * cmath.exp(1j * self.nu2 * u)
         return self.C + X.real, self.Gt0 + X.imag
 
-    def run(self, rem: float) -> SegmentEnd:
-        """Roll up to ``rem`` seconds or until the first exit (lift-off or friction cone)."""
+    def run(self, rem: float, cone_slack: float = 0.0) -> SegmentEnd:
+        """Roll up to ``rem`` seconds or until the first exit (lift-off or friction cone).
+
+        ``cone_slack`` (1/s^2) > 0 ignores cone violations smaller than it: used after a
+        sliding attempt proved unable to leave zero slip (a violation below resolution).
+        """
         tally = ContactTally()
         names = ("lift_off", "cone", "cone")
         x_end, kind = rem, None
-        for fn, name in zip(self.exits(), names):
+        for i, (fn, name) in enumerate(zip(self.exits(), names)):
+            if i > 0 and cone_slack > 0.0:
+                fn = TrigSum(fn.C + cone_slack, fn.a1, fn.a2, fn.nu1, fn.nu2)
             x = fn.first_zero(x_end, tally)
             if x is not None and x < x_end:
                 x_end, kind = x, name
