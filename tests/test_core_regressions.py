@@ -67,6 +67,13 @@ CASES = {
              mu=2.4155040090266096e-192, d=0.0, g=0.0, levitate=False),
         1.0, 1 + 0j, 0j, [(1.0, -1.0, 0.0, 0.0)],
     ),
+    # ... and with a force of 1e-47 N: rolling left the cone at once, sliding could not
+    # leave zero slip, and the two alternated at t = 0
+    "negligible friction and force": (
+        dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1e-09, R=1e-09,
+             mu=2.4155040090266096e-192, d=0.0, g=0.0, levitate=False),
+        1.0, 1 + 0j, 0j, [(1.0, -1.0, 0.0, 1.175494351e-38)],
+    ),
     # a denormal outward force made the low-speed rule divide by zero
     "denormal outward force": (
         dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,

@@ -199,6 +199,7 @@ class TouchdownCore:
         self._locked = False
         self._on_wall = abs(z0) >= params.c_r * (1.0 - 1e-15)
         self._clear = False
+        self._roll_lenient = False  # in a step: zero slip proved stuck (_transition)
         self._n_impacts = 0
         self._t_last = 0.0
         self._v_last = 0.0
@@ -379,6 +380,7 @@ class TouchdownCore:
         self._set_inputs(W, F, a)
         tally = _Tally()
         work = Work()
+        self._roll_lenient = False
         cap = work_cap(self._p, h, W, F, a, abs(self._v))
         rep = StepReport(work_cap=cap)
         t0, s = self._t, 0.0
@@ -580,7 +582,8 @@ class TouchdownCore:
             self._lift_off()
             return s
         if self._mode == MODE_ROLLING:
-            end = Rolling(wf, self._theta, E).run(rem)
+            slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if self._roll_lenient else 0.0
+            end = Rolling(wf, self._theta, E).run(rem, cone_slack=slack)
         elif self._try_lock(E):
             end = self._locked_rotation(rem, E)
         else:
@@ -621,10 +624,11 @@ class TouchdownCore:
             self._dtheta = -wf.wr
             self._choose_contact_mode()
             self._locked = False
-        elif event == "slip_stuck":  # sliding cannot leave zero slip: it rolls
-            self._dtheta = -wf.wr
+        elif event == "slip_stuck":  # sliding cannot leave zero slip: it rolls, and
+            self._dtheta = -wf.wr  # cone violations below resolution are ignored this step
             self._mode = MODE_ROLLING
             self._locked = False
+            self._roll_lenient = True
         elif event == "cone":
             _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
