@@ -395,10 +395,17 @@ class Rolling:
         """
         tally = ContactTally()
         names = ("lift_off", "cone", "cone")
+        # an exit happens once its function is past the rounding band that the mode
+        # choice (simulator: _leaves_wall, _choose_contact_mode) also uses
+        band = self.wf.gn_tol(self.dtheta)
+        shifts = (
+            band,
+            band * (1.0 + self.wf.mu) + cone_slack,
+            band * (1.0 + self.wf.mu) + cone_slack,
+        )
         x_end, kind = rem, None
-        for i, (fn, name) in enumerate(zip(self.exits(), names)):
-            if i > 0 and cone_slack > 0.0:
-                fn = TrigSum(fn.C + cone_slack, fn.a1, fn.a2, fn.nu1, fn.nu2)
+        for fn, name, shift in zip(self.exits(), names, shifts):
+            fn = TrigSum(fn.C + shift, fn.a1, fn.a2, fn.nu1, fn.nu2)
             x = fn.first_zero(x_end, tally)
             if x is not None and x < x_end:
                 x_end, kind = x, name
