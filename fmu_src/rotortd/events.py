@@ -69,10 +69,6 @@ class Contact:
     kind: str
 
 
-class SearchExhausted(RuntimeError):
-    """The contact search hit its work cap (a pathological flight)."""
-
-
 def _cubic(g0: float, g1: float, g2: float, g3: float, u: float) -> float:
     return g0 + u * (g1 + u * (0.5 * g2 + u * g3 / 6.0))
 

@@ -43,7 +43,7 @@ from .contact import (
     phase_integral,
     wrap_angle,
 )
-from .events import ContactLocator, SearchExhausted, Work
+from .events import ContactLocator, Work
 from .flight import FlightModel
 from .impact import Impact, reset
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
@@ -392,7 +392,7 @@ class TouchdownCore:
                 s = self._advance(s, h, t0, tally, work)
                 if self._mode != mode:
                     tally.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
-        except (WorkCapExceeded, SearchExhausted, ContactWorkExceeded) as exc:
+        except (WorkCapExceeded, ContactWorkExceeded) as exc:
             rep.status, rep.message = STATUS_WORK_CAP, f"t = {t0 + s!r} s: {exc}"
             work.iters += getattr(exc, "work", 0)
         self._tick(h if s >= h else s)

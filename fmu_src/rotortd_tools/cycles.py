@@ -34,7 +34,7 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 from rotortd import RotorParams, ScaledParams, TouchdownCore, WallForces, forward_rub_equilibria
-from rotortd.events import Contact, ContactLocator, SearchExhausted, Work
+from rotortd.events import Contact, ContactLocator, Work
 from rotortd.flight import FlightModel
 from rotortd.impact import reset
 
@@ -823,7 +823,7 @@ def continue_branch(
         y_pred = y + ds * t
         try:
             y_new, fl, DF, Jx = _correct(y_pred, t)
-        except (NewtonFailed, NoImpact, SearchExhausted, np.linalg.LinAlgError):
+        except (NewtonFailed, NoImpact, np.linalg.LinAlgError):
             ds *= 0.5
             continue
         if np.linalg.norm(y_new - y) > 3.0 * ds:  # jumped to another branch
@@ -852,7 +852,7 @@ def _refine(branch: str, a: BranchPoint, b: BranchPoint, key, event: str) -> Bra
         x = np.array(pa.x) + w * (np.array(pb.x) - np.array(pa.x))
         try:
             cyc = cycle_at(chapter_params(gamma=g), x, branch)
-        except (NewtonFailed, NoImpact, SearchExhausted):
+        except (NewtonFailed, NoImpact):
             break
         lam = cyc.multipliers
         p = BranchPoint(
