@@ -74,6 +74,12 @@ CASES = {
              mu=2.4155040090266096e-192, d=0.0, g=0.0, levitate=False),
         1.0, 1 + 0j, 0j, [(1.0, -1.0, 0.0, 1.175494351e-38)],
     ),
+    # a denormal force: half the cubic's third coefficient underflowed to exactly 0
+    "denormal cubic coefficient": (
+        dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1e-06, R=1e-06, mu=0.0, d=0.0,
+             g=0.0, levitate=False),
+        1.0, 0j, 2 + 0j, [(1.0, 1.0, 0.0, 2.2250738585e-313)],
+    ),
     # a denormal outward force made the low-speed rule divide by zero
     "denormal outward force": (
         dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,

@@ -12,7 +12,7 @@ import cmath
 import math
 
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, given, seed, settings
 from hypothesis import strategies as st
 from rotortd import RotorParams, ScaledParams, TouchdownCore, work_cap
 

@@ -76,11 +76,11 @@ def _cubic(g0: float, g1: float, g2: float, g3: float, u: float) -> float:
 def _critical_points(g1: float, g2: float, g3: float, tau: float) -> list[float]:
     """Roots in (0, tau) of p'(u) = g1 + g2 u + g3 u^2/2, sorted."""
     pts: list[float] = []
-    if g3 == 0.0:
+    a = 0.5 * g3  # may underflow to 0 for a denormal g3: branch on a itself
+    if a == 0.0:
         if g2 != 0.0:
             pts.append(-g1 / g2)
     else:
-        a = 0.5 * g3
         disc = g2 * g2 - 4.0 * a * g1
         if disc >= 0.0:
             r = disc**0.5
@@ -137,7 +137,7 @@ def _bracket_left(f, lo: float, hi: float, work: Work) -> float:
         work.iters += 1
         if hi - lo <= 4.0 * EPS * hi:
             break
-        x = (lo * fhi - hi * flo) / (fhi - flo)
+        x = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
         if not lo < x < hi:
             x = 0.5 * (lo + hi)
         fx = f(x)
