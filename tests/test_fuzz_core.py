@@ -65,10 +65,11 @@ def scenes(draw: st.DrawFn) -> tuple:
     return p, W_ref, U0, dU0, steps
 
 
+@seed(20261121)  # the same examples on every machine and path: CI explores what we verify
 @settings(
     max_examples=10_000,
     deadline=None,
-    derandomize=True,
+    database=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 @given(scenes())
