@@ -80,6 +80,15 @@ CASES = {
              g=0.0, levitate=False),
         1.0, 0j, 2 + 0j, [(1.0, 1.0, 0.0, 2.2250738585e-313)],
     ),
+    # an oversized first sliding step overflowed: NaN error estimate taken as acceptance
+    "overflowing trial step": (
+        dict(m=1.1501811128474624, c=0.0006008940895357105, k=0.0, e_c=0.0, phi=0.0,
+             c_r=1e-09, R=8.204696109024991e-09, mu=1.0039146309357434, d=0.8984375, g=0.0,
+             levitate=False),
+        2.4142303421860594, 0j, 2.420150349722683 + 0.9130187576874073j,
+        [(1.0, 1.0, 0.0, 0.25), (0.434421818256383, -1.0, 1.0, 0.0),
+         (1.0, 1.0, 0.0, 0.6683298125519929)],
+    ),
     # a denormal outward force made the low-speed rule divide by zero
     "denormal outward force": (
         dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,

@@ -211,8 +211,8 @@ class Sliding:
                 self.rhs, u, y, f0, step, self.scale, k_min=K_MIN
             )
             tally.work += nfev
-            if err > 1.0:
-                H = gbs.next_step_size(step, err, k)
+            if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
+                H = gbs.next_step_size(step, err, k) if err == err else 0.1 * step
                 continue
             gn, sv = self.events(y_new, u + step)
             if gn <= 0.0 or sv <= 0.0:
