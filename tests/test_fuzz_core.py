@@ -12,7 +12,7 @@ import cmath
 import math
 
 import pytest
-from hypothesis import HealthCheck, assume, given, seed, settings
+from hypothesis import HealthCheck, Phase, assume, given, seed, settings
 from hypothesis import strategies as st
 from rotortd import RotorParams, ScaledParams, TouchdownCore, work_cap
 
@@ -70,6 +70,7 @@ def scenes(draw: st.DrawFn) -> tuple:
     max_examples=10_000,
     deadline=None,
     database=None,
+    phases=[Phase.explicit, Phase.reuse, Phase.generate],  # no shrinking: report fast
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 @given(scenes())

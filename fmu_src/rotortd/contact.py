@@ -164,8 +164,17 @@ class SegmentEnd:
 class Sliding:
     """One sliding segment with slip sign ``s`` from (theta0, dtheta0, E0)."""
 
-    def __init__(self, wf: WallForces, theta0: float, dtheta0: float, E0: complex, s: float):
+    def __init__(
+        self,
+        wf: WallForces,
+        theta0: float,
+        dtheta0: float,
+        E0: complex,
+        s: float,
+        gn_slack: float = 0.0,
+    ) -> None:
         self.wf = wf
+        self.gn_slack = gn_slack  # lift-off only once Gn < -gn_slack (1/s^2)
         self.s = s
         self.mus = wf.mu * s
         self.theta0 = theta0
@@ -191,6 +200,7 @@ class Sliding:
         """(Gn, s v_rel/c_r) at state y and local time u: contact ends when either is <= 0."""
         E = self.E0 * cmath.exp(1j * self.wf.Omega * u)
         gn, _ = self.wf.gn_gt(y[0], y[1], E)
+        gn += self.gn_slack
         if self.wf.mu == 0.0:  # frictionless: the slip direction carries no physics
             return gn, 1.0
         return gn, self.s * (self.wf.wr + y[1])

@@ -200,6 +200,7 @@ class TouchdownCore:
         self._on_wall = abs(z0) >= params.c_r * (1.0 - 1e-15)
         self._clear = False
         self._roll_lenient = False  # in a step: zero slip proved stuck (_transition)
+        self._sticky_at = math.nan  # in a step: where flight and contact swapped at N = 0
         self._n_impacts = 0
         self._t_last = 0.0
         self._v_last = 0.0
@@ -381,6 +382,7 @@ class TouchdownCore:
         tally = _Tally()
         work = Work()
         self._roll_lenient = False
+        self._sticky_at = math.nan
         cap = work_cap(self._p, h, W, F, a, abs(self._v))
         rep = StepReport(work_cap=cap)
         t0, s = self._t, 0.0
@@ -388,10 +390,12 @@ class TouchdownCore:
             while s < h:
                 if work.total > cap:
                     raise WorkCapExceeded(f"step work exceeded its cap {cap}")
-                mode = self._mode
+                mode, s_before = self._mode, s
                 s = self._advance(s, h, t0, tally, work)
                 if self._mode != mode:
                     tally.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
+                    if s == s_before and MODE_FREE in (mode, self._mode):
+                        self._sticky_at = s  # N = 0 to rounding: contact holds past it
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
             rep.status, rep.message = STATUS_WORK_CAP, f"t = {t0 + s!r} s: {exc}"
             work.iters += getattr(exc, "work", 0)
@@ -578,7 +582,8 @@ class TouchdownCore:
             self._mode == MODE_SLIDING and vrel * self._slip <= 0.0 and wf.mu != 0.0
         ):
             self._choose_contact_mode()  # the host changed Omega: the slip follows v_rel
-        if self._leaves_wall(E):
+        sticky = s == self._sticky_at
+        if not sticky and self._leaves_wall(E):
             self._lift_off()
             return s
         if self._mode == MODE_ROLLING:
@@ -587,7 +592,8 @@ class TouchdownCore:
         elif self._try_lock(E):
             end = self._locked_rotation(rem, E)
         else:
-            end, self._H = Sliding(wf, self._theta, self._dtheta, E, self._slip).run(
+            slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
+            end, self._H = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack).run(
                 rem, self._H if math.isfinite(self._H) else 0.05 / wf.omega_ref(self._dtheta)
             )
         work.iters += end.tally.work
