@@ -14,8 +14,8 @@ bounds wall time, not what is checked).
 from __future__ import annotations
 
 import cmath
-import os
 import math
+import os
 
 import pytest
 from hypothesis import HealthCheck, Phase, assume, given, seed, settings
