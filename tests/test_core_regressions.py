@@ -100,14 +100,6 @@ CASES = {
          (2.5910310228484863, 0.37, 1.0, 2.2250738585072014e-308),
          (1.7139042566149303, 1.0, 0.5, 1.6169902024107445)],
     ),
-    # at rest on the wall under a subnormal force: flight and contact disagreed in sign
-    "resting on the wall, subnormal force": (
-        dict(m=10.0**1.9, c=0.0, k=0.0, e_c=1e-06, phi=1.1125369292536007e-308, c_r=1e-06,
-             R=1.405501431695455e-05, mu=1.9364382076413014, d=0.0, g=0.0, levitate=True),
-        1.0, 0j, -2.1400964702331264 - 0.4509544463178215j,
-        [(2.1001913985461242, 0.0, 0.0, 0.0),
-         (0.00016106877466719004, 0.0, 0.5, 2.225073858507203e-309)],
-    ),
     # a denormal outward force made the low-speed rule divide by zero
     "denormal outward force": (
         dict(m=1.0, c=0.0, k=0.0, e_c=0.0, phi=0.0, c_r=1.0, R=1.0, mu=0.0, d=1e-06, g=0.0,

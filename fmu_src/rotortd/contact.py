@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 from . import gbs
 from .divdiff import dd2
-from .params import RotorParams, flush_subnormal
+from .params import RotorParams
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""
@@ -81,8 +81,8 @@ class WallForces:
         """Forces for parameters ``p`` and the inputs held over a step."""
         mc = p.m * p.c_r
         return cls(
-            q0=flush_subnormal((amb * p.bias_force + p.gravity_force + complex(F_ext)) / mc),
-            eu=flush_subnormal(p.e_c * Omega * Omega * cmath.exp(1j * p.phi) / p.c_r),
+            q0=(amb * p.bias_force + p.gravity_force + complex(F_ext)) / mc,
+            eu=p.e_c * Omega * Omega * cmath.exp(1j * p.phi) / p.c_r,
             beta=amb * p.c / p.m,
             kappa=amb * p.k / p.m,
             Omega=Omega,

@@ -26,7 +26,7 @@ import math
 from dataclasses import dataclass
 
 from .divdiff import dd2, dd3
-from .params import RotorParams, flush_subnormal
+from .params import RotorParams
 
 
 @dataclass(frozen=True)
@@ -67,8 +67,8 @@ class FlightModel:
         self.amb = float(amb)
         self.beta = amb * p.c / p.m
         self.kappa = amb * p.k / p.m
-        self.f0 = flush_subnormal((amb * p.bias_force + p.gravity_force + self.F_ext) / p.m)
-        self.F1 = flush_subnormal(p.e_c * self.Omega * self.Omega * cmath.exp(1j * p.phi))
+        self.f0 = (amb * p.bias_force + p.gravity_force + self.F_ext) / p.m
+        self.F1 = p.e_c * self.Omega * self.Omega * cmath.exp(1j * p.phi)
         self.c_r = p.c_r
         self.l1, self.l2 = _eigenvalues(self.beta, self.kappa)
         self.K = self.kappa * p.c_r + abs(self.f0) + abs(self.F1)

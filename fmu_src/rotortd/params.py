@@ -9,20 +9,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
-TINY = 2.2250738585072014e-308
-"""Smallest normal double; force terms below it are flushed to 0 (see flush_subnormal)."""
-
-
-def flush_subnormal(x: complex) -> complex:
-    """x with subnormal real/imaginary parts set to 0.
-
-    A subnormal force has lost its significant bits, so quantities derived from it along
-    different paths (the flight's g'' and the contact's N) could disagree even in sign.
-    """
-    re = x.real if abs(x.real) >= TINY else 0.0
-    im = x.imag if abs(x.imag) >= TINY else 0.0
-    return complex(re, im)
-
 
 class ParameterError(ValueError):
     """A parameter or initial state is invalid; the message names it and its allowed range."""
