@@ -49,7 +49,7 @@ from .impact import Impact, reset
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
 
 MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
-STATUS_OK, STATUS_WORK_CAP, STATUS_ACCUMULATION = 0, 1, 2
+STATUS_OK, STATUS_WORK_CAP = 0, 1
 STATE_SCHEMA, STATE_VERSION = "rotortd-state", 1
 _MODE_NAMES = {MODE_FREE: "lift_off", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
 
@@ -334,8 +334,8 @@ class TouchdownCore:
     def t_contact_entry(self) -> float:
         """Estimated accumulation point (s) of the last chattering that became contact.
 
-        The plastic impact time plus 2 d v/((1-d) A) for rule (1), the impact time
-        otherwise; NaN before any.
+        The plastic impact time plus the geometric remainder 2 d v/((1-d) A) for d < 1,
+        the impact time for d = 1; NaN before any.
         """
         return self._t_contact
 
@@ -479,7 +479,7 @@ class TouchdownCore:
             self._impact(t0 + s + ds, z, hit.v, tally)
         else:
             self._z, self._v = z, hit.v
-            self._enter_contact(tally, work)
+            self._enter_contact()
         return s + ds if ds > 0.0 else s + 0.0
 
     def _impact(self, t: float, z: complex, v_minus: complex, tally: _Tally) -> None:
@@ -504,7 +504,7 @@ class TouchdownCore:
             A = self._outward_accel(n, r.v_plus)
             d = p.d
             self._t_contact = t + (2.0 * d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)
-            self._enter_contact(tally, Work())
+            self._enter_contact()
 
     def _outward_accel(self, n: complex, v: complex) -> float:
         """A (m/s^2): outward normal acceleration at the wall from contact-free forces."""
@@ -534,15 +534,11 @@ class TouchdownCore:
 
     # ------------------------------------------------------------------ contact
 
-    def _enter_contact(self, tally: _Tally, work: Work) -> None:
+    def _enter_contact(self) -> None:
         """Switch to sustained contact at the current (on-wall) state."""
-        p = self._p
         z, v = self._z, self._v
-        n = z / abs(z)
         self._theta = cmath.phase(z)
-        self._dtheta = (n.conjugate() * v).imag / p.c_r
-        self._z = p.c_r * cmath.exp(1j * self._theta)
-        self._mode = MODE_SLIDING
+        self._dtheta = ((z / abs(z)).conjugate() * v).imag / self._p.c_r
         self._locked = False
         self._choose_contact_mode()
         self._sync_from_contact()
