@@ -106,6 +106,25 @@ CASES = {
              levitate=False),
         10.0, 0j, 1 + 0j, [(1.0, 1.0, 0.0, 5e-324)],
     ),
+    # at rest on the wall under a 1e-313 N force pulling inward: g'' = 2 Re(conj(z) z'')
+    # kept a few subnormal bits of the wrong sign, and the cubic's value underflowed to
+    # -0.0, a false root; flight and contact swapped with 1e-16 s progress each
+    "subnormal force at rest on the wall": (
+        dict(m=79.43282347242814, c=0.0, k=0.0, e_c=1e-06, phi=1.11e-308, c_r=1e-06,
+             R=1.4055e-05, mu=1.936, d=0.0, g=0.0, levitate=True),
+        1.0, 0j, -2.1401 - 0.451j,
+        [(2.1001913985461242, 0.0, 0.0, 0.0),
+         (0.00016106877466719004, 0.0, 0.5, 2.225073858507203e-309)],
+    ),
+    # lift-off onto a free orbit that is the wall itself to rounding (spring force =
+    # centripetal force, light damping): g' and g'' were noise, the safe steps 1e-12 s
+    "orbit hugging the wall after lift-off": (
+        dict(m=3.1622776601683795, c=2.18e-4, k=31.6, e_c=7.8e-3, phi=1.1675, c_r=1.0,
+             R=16.4, mu=1.71, d=1.0, g=0.0, levitate=True),
+        3.1622776601683795, 0.8775825618903728 + 0.479425538604203j,
+        0.13207114752408347 - 0.2417546139353087j,
+        [(7.943282347242816, 0.0, 0.5, 8.636e-14), (1.0, 0.0, 0.0, 1.2e-85)],
+    ),
     # k = 2e-200: the steady offset f0/kappa overflowed in the envelope bound
     "tiny stiffness": (
         dict(m=1.0, c=0.0, k=1.9729346285183482e-200, e_c=0.0, phi=0.0, c_r=1e-09, R=1e-09,

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 from . import gbs
 from .divdiff import dd2
+from .events import G2_FLOOR
 from .params import RotorParams
 
 RTOL = 1e-13
@@ -75,6 +76,9 @@ class WallForces:
     Omega: float
     wr: float
     mu: float
+    gn_floor: float = 0.0
+    """Absolute part of Gn's rounding band (1/s^2): the underflow error of subnormal
+    forces. A quarter of the free flight's band of g'' = 2 c_r^2 Gn (events.G2_FLOOR)."""
 
     @classmethod
     def build(cls, p: RotorParams, Omega: float, F_ext: complex, amb: float) -> WallForces:
@@ -88,6 +92,7 @@ class WallForces:
             Omega=Omega,
             wr=p.R * Omega / p.c_r,
             mu=p.mu,
+            gn_floor=G2_FLOOR / (8.0 * p.c_r * p.c_r),
         )
 
     def gn_gt(self, theta: float, dtheta: float, E: complex) -> tuple[float, float]:
@@ -116,6 +121,7 @@ class WallForces:
             64.0
             * 2.220446049250313e-16
             * (abs(self.q0) + abs(self.eu) + self.kappa + dtheta * dtheta)
+            + self.gn_floor
         )
 
     def omega_ref(self, dtheta: float) -> float:

@@ -28,6 +28,7 @@ contact (the free motion curves outward, g'' > 0) and flying on (g'' <= 0).
 from __future__ import annotations
 
 import cmath
+import math
 from dataclasses import dataclass
 
 from .flight import FlightModel
@@ -35,6 +36,15 @@ from .flight import FlightModel
 EPS = 2.220446049250313e-16
 TOL_G_ULPS = 64.0
 """Contact resolution: g >= -TOL_G_ULPS * eps * c_r^2 counts as at the wall."""
+TINY = 5e-324
+"""Smallest subnormal double: the absolute rounding error of an operation that underflows."""
+G2_FLOOR = 1024.0 * TINY
+"""Absolute part of the rounding bands of g' and g'' (m^2/s, m^2/s^2): with subnormal
+forces or speeds their relative bands vanish, but the products in g' and g'' still carry
+an absolute error of a few TINY, enough to flip a sign (fuzzing: a 1e-313 N force)."""
+HORIZON = 0.25
+"""Longest interval (in units of 1/w, w the flight's fastest rate) one cubic bound covers:
+the bound of g''' grows with the interval, so a longer one only shortens the safe step."""
 MAX_ADVANCES = 400
 """Advances in one search call (a grazing pass needs ~40); a flight creeping along the
 wall for long may need more, and the caller then resumes from where the search stopped."""
@@ -92,12 +102,23 @@ def _critical_points(g1: float, g2: float, g3: float, tau: float) -> list[float]
     return sorted(u for u in pts if 0.0 < u < tau)
 
 
+def _unit_scale(g0: float, g1: float, g2: float, g3: float) -> tuple[float, ...]:
+    """The coefficients times a power of two (exact) that brings the largest near 1, when
+    all are below 2^-600: else p(u) of subnormal forces underflows to -0.0, a false root."""
+    big = max(abs(g0), abs(g1), abs(g2), abs(g3))
+    if big == 0.0 or big >= 2.0**-600:
+        return g0, g1, g2, g3
+    e = -math.frexp(big)[1]
+    return math.ldexp(g0, e), math.ldexp(g1, e), math.ldexp(g2, e), math.ldexp(g3, e)
+
+
 def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work) -> float | None:
     """Lower bound of the first root in (0, tau] of p(u) = g0 + g1 u + g2 u^2/2 + g3 u^3/6.
 
     Requires g0 <= 0 (g0 == 0 means 'on the wall'; then p(u)/u is examined). Returns
     None when p < 0 on all of (0, tau]; otherwise a u > 0 with p < 0 on (0, u].
     """
+    g0, g1, g2, g3 = _unit_scale(g0, g1, g2, g3)
     if g0 == 0.0:
         return _safe_step_on_wall(g1, g2, g3, tau, work)
     knots = [0.0, *_critical_points(g1, g2, g3, tau), tau]
@@ -162,6 +183,8 @@ class ContactLocator:
         self.z0, self.v0, self.E0 = z0, v0, E0
         self.c2 = fm.c_r * fm.c_r
         self.tol_g = TOL_G_ULPS * EPS * self.c2
+        w = max(fm.rate, abs(v0) / fm.c_r)
+        self.horizon = HORIZON / w if w > 0.0 else math.inf
 
     def state(self, s: float, work: Work) -> tuple[complex, complex, complex]:
         """Exact (z, v, E) at local time s, from the flight's start (no drift)."""
@@ -176,11 +199,32 @@ class ContactLocator:
         return 6.0 * (v.conjugate() * acc).real + 2.0 * (z.conjugate() * jerk).real
 
     def grace_step(self, z: complex, v: complex, E: complex) -> float:
-        """Time (s) a tangential departure (g = g' = 0, g'' at rounding level, g3 < 0)
-        needs to get 8 TOL_G inside: (48 TOL_G/|g3|)^(1/3). There g'' is noise and the
-        cubic term governs, so no contact can occur within it."""
+        """Step (s) off the wall for a tangential departure: g, g', g'' zero to resolution
+        and g3 <= 0, so that the cubic term governs.
+
+        The larger of (a) the time the cubic needs to get 8 TOL_G inside,
+        (48 TOL_G/|g3|)^(1/3), capped at 4|g3|/(G3 w) (w the flight's fastest rate) so
+        that the cubic still dominates the quartic term, and (b) the time the bound G3 of
+        |g3| needs to move the rotor TOL_G outward, (6 TOL_G/G3)^(1/3), within which no
+        contact can be resolved whatever g3 is (g3 = 0: a rotor at rest on the wall)."""
         g3 = self.g3(z, v, E)
-        return (48.0 * self.tol_g / max(-g3, 1e-300)) ** (1.0 / 3.0)
+        fm = self.fm
+        G3 = self.g3_bound(v, 0.0)
+        w = max(fm.rate, abs(v) / fm.c_r)
+        cubic = (48.0 * self.tol_g / max(-g3, 1e-300)) ** (1.0 / 3.0)
+        if G3 * w > 0.0:
+            cubic = min(cubic, 4.0 * abs(g3) / (G3 * w))
+        return max(cubic, (6.0 * self.tol_g / G3) ** (1.0 / 3.0))
+
+    def bands(self, v: complex) -> tuple[float, float]:
+        """Rounding bands of g' (m^2/s) and g'' (m^2/s^2) at the wall with velocity v. The
+        band of g'' = 2 c_r^2 Gn is four times wider than the contact side's band of Gn
+        (WallForces.gn_tol), so a state is never 'pressing' here and 'leaving' there."""
+        fm = self.fm
+        force = abs(fm.f0) + abs(fm.F1) + fm.kappa * fm.c_r + fm.beta * abs(v)
+        tol_g1 = 16.0 * EPS * fm.c_r * abs(v) + G2_FLOOR
+        tol_g2 = 256.0 * EPS * (abs(v) ** 2 + fm.c_r * force) + G2_FLOOR
+        return tol_g1, tol_g2
 
     def g3_bound(self, v: complex, tau: float) -> float:
         """Bound G3 (m^2/s^3) of |g'''| on an interval of length tau starting at velocity v."""
@@ -188,7 +232,7 @@ class ContactLocator:
         V = abs(v) + fm.K * tau
         A = fm.beta * V + fm.K
         Jm = fm.beta * A + fm.kappa * V + fm.J
-        return 6.0 * V * A + 2.0 * fm.c_r * Jm
+        return 6.0 * V * A + 2.0 * fm.c_r * Jm + TINY  # rounded up, never 0 by underflow
 
     def find(self, h: float, on_wall: bool, work: Work) -> Contact | None:
         """First contact in (0, h], or None. ``on_wall``: the start lies on the circle."""
@@ -205,7 +249,8 @@ class ContactLocator:
                 if hit is not None:
                     return hit
                 g, g1 = 0.0, min(g1, 0.0)
-                if g1 == 0.0 and g2 >= 0.0 and s < h:  # tangential departure, g3 < 0
+                tol_g1, tol_g2 = self.bands(v)
+                if g1 >= -tol_g1 and g2 >= -tol_g2 and s < h:  # tangential departure
                     s = min(h, s + self.grace_step(z, v, E))
                     z, v, E = self.state(s, work)
                     continue
@@ -226,10 +271,10 @@ class ContactLocator:
         self, g: float, g1: float, g2: float, v: complex, remaining: float, work: Work
     ) -> float | None:
         """A safe step (s) from the current point, or None if no contact in `remaining`."""
-        tau = remaining
+        tau = min(remaining, self.horizon)
         u = safe_step(g, g1, g2, self.g3_bound(v, tau), tau, work)
         if u is None:
-            return None
+            return tau if tau < remaining else None
         for _ in range(2):  # tighten the bound on a shorter interval
             if u <= 0.0 or u >= 0.25 * tau:
                 break
@@ -253,7 +298,7 @@ class ContactLocator:
         first: bool,
     ) -> Contact | None:
         """Classify a point at the wall: impact, touch, or None (leaving / grazing by)."""
-        tol_g1 = 16.0 * EPS * self.fm.c_r * abs(v)  # resolution of g' = 2 c_r rdot
+        tol_g1, tol_g2 = self.bands(v)
         outward = g1 > tol_g1
         if outward and g2 < 0.0:
             outward = g + g1 * g1 / (-2.0 * g2) > self.tol_g  # resolvable excursion
@@ -263,11 +308,6 @@ class ContactLocator:
             return self._polish(s, z, v, E, g, g1, work)
         if g1 < -tol_g1:
             return None
-        # rounding band of g'' = 2 c_r^2 Gn, four times wider than the contact side's band
-        # of Gn (WallForces.gn_tol), so a state is never 'pressing' here and 'leaving' there
-        fm = self.fm
-        force = abs(fm.f0) + abs(fm.F1) + fm.kappa * fm.c_r + fm.beta * abs(v)
-        tol_g2 = 256.0 * EPS * (abs(v) ** 2 + fm.c_r * force)
         if g2 > tol_g2 or (g2 >= -tol_g2 and self.g3(z, v, E) > 0.0):
             return Contact(s, z, v, E, "touch")
         return None

@@ -73,6 +73,9 @@ class FlightModel:
         self.l1, self.l2 = _eigenvalues(self.beta, self.kappa)
         self.K = self.kappa * p.c_r + abs(self.f0) + abs(self.F1)
         self.J = abs(self.Omega) * abs(self.F1)
+        self.rate = max(abs(self.Omega), self.kappa**0.5, self.beta, (self.K / p.c_r) ** 0.5)
+        """Fastest rate of the forced motion (rad/s): |Omega|, sqrt(kappa), beta and
+        sqrt(K/c_r), the rate at which the largest force crosses the clearance."""
         self._cache: dict[float, FlightCoeffs] = {}
 
     # -- propagation --------------------------------------------------------------------
