@@ -31,6 +31,7 @@ from __future__ import annotations
 import cmath
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from .contact import (
     ContactTally,
@@ -93,13 +94,13 @@ class StepReport:
     """Mode changes in the step: (t, "sliding" | "rolling" | "lift_off")."""
 
 
-@dataclass(frozen=True)
-class Kinematics:
+class Kinematics(NamedTuple):
     """Outputs derived from the state (SI; u_*, du_* scaled co-rotating, t = Omega tau).
 
     x, y (m), vx, vy (m/s), r_rel = |z|/c_r, u = z e^{-i psi}/c_r, du = dU/dt (0 when
     Omega = 0), psi_wrapped (rad, (-pi, pi]), whirl_rate theta' (rad/s, inertial),
-    v_rel = R Omega + c_r theta' (m/s), F_amb = a (F_bias - c v - k z) (N).
+    v_rel = R Omega + c_r theta' (m/s), F_amb = a (F_bias - c v - k z) (N). A named tuple:
+    the fields unpack in this order.
     """
 
     x: float
@@ -148,16 +149,23 @@ def work_cap(
     sqrt(F/(m c_r)) at which the largest force moves the rotor across the clearance, and
     the rate speed/c_r of the rotor's own speed (m/s) at the start of the step.
     """
+    return _cap(h, _input_rate(p, Omega, F_ext, amb), speed / p.c_r)
+
+
+def _input_rate(p: RotorParams, Omega: float, F_ext: complex, amb: float) -> float:
+    """The part of work_cap's w_max (rad/s) fixed by the parameters and held inputs."""
     force = abs(F_ext) + p.m * p.g + amb * p.m * p.g * p.levitate + p.m * p.e_c * Omega**2
-    w_max = max(
+    return max(
         abs(Omega),
         p.R * abs(Omega) / p.c_r,
         math.sqrt(amb * p.k / p.m),
         amb * p.c / p.m,
         math.sqrt(force / (p.m * p.c_r)),
-        speed / p.c_r,
     )
-    return int(WORK_BASE + WORK_PER_RADIAN * min(h * w_max, 1e12))
+
+
+def _cap(h: float, w_inputs: float, w_speed: float) -> int:
+    return int(WORK_BASE + WORK_PER_RADIAN * min(h * max(w_inputs, w_speed), 1e12))
 
 
 class TouchdownCore:
@@ -208,6 +216,7 @@ class TouchdownCore:
         self._t_contact = math.nan
         self._H = math.inf
         self._inputs: tuple[float, complex, float] = (0.0, 0j, 1.0)
+        self._w_inputs = 0.0  # _input_rate of the held inputs (rad/s)
         self._fm: FlightModel | None = None
         self._wf: WallForces | None = None
 
@@ -372,18 +381,19 @@ class TouchdownCore:
 
     def step(self, h: float, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0) -> StepReport:
         """Advance by h seconds with Omega (rad/s), F_ext (N) and amb_on held."""
-        h = check_range("h", h, 0.0, lo_open=True, error=InputError, unit="s")
-        W = check_finite("Omega", Omega, InputError)
         F = complex(F_ext)
-        check_finite("F_x", F.real, InputError)
-        check_finite("F_y", F.imag, InputError)
-        a = check_range("amb_on", amb_on, 0.0, 1.0, error=InputError)
+        if not (0.0 < h < math.inf and math.isfinite(Omega) and 0.0 <= amb_on <= 1.0
+                and math.isfinite(F.real) and math.isfinite(F.imag)):
+            self._reject_inputs(h, Omega, F, amb_on)
+        W, a = float(Omega), float(amb_on)
         self._set_inputs(W, F, a)
+        cap = _cap(h, self._w_inputs, abs(self._v) / self._p.c_r)
+        if self._clear and self._mode == MODE_FREE:
+            return self._clear_flight(h, cap)
         tally = _Tally()
         work = Work()
         self._roll_lenient = False
         self._sticky_at = math.nan
-        cap = work_cap(self._p, h, W, F, a, abs(self._v))
         rep = StepReport(work_cap=cap)
         t0, s = self._t, 0.0
         try:
@@ -403,6 +413,26 @@ class TouchdownCore:
         self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
         return rep
 
+    def _clear_flight(self, h: float, cap: int) -> StepReport:
+        """A step of a flight that the envelope proved never reaches the wall under the
+        held inputs (``_clear``): one closed-form propagation, nothing to search or tally."""
+        fm = self._fm
+        assert fm is not None
+        self._z, self._v = fm.propagate(self._z, self._v, self._phasor(), h, cache=True)
+        self._advance_psi(h)
+        self._on_wall = False
+        self._tick(h)
+        return StepReport(work=1, work_cap=cap)
+
+    @staticmethod
+    def _reject_inputs(h: float, Omega: float, F: complex, amb_on: float) -> None:
+        """Raise the InputError that names the first invalid input of a step."""
+        check_range("h", h, 0.0, lo_open=True, error=InputError, unit="s")
+        check_finite("Omega", Omega, InputError)
+        check_finite("F_x", F.real, InputError)
+        check_finite("F_y", F.imag, InputError)
+        check_range("amb_on", amb_on, 0.0, 1.0, error=InputError)
+
     def _tick(self, dt: float) -> None:
         """Advance the clock by dt with compensated summation (no drift over 1e6 steps)."""
         y = dt - self._t_lo
@@ -413,6 +443,7 @@ class TouchdownCore:
     def _set_inputs(self, W: float, F: complex, a: float) -> None:
         if (W, F, a) != self._inputs or self._fm is None:
             self._inputs = (W, F, a)
+            self._w_inputs = _input_rate(self._p, W, F, a)
             self._fm = FlightModel(self._p, W, F, a)
             self._wf = WallForces.build(self._p, W, F, a)
             self._clear = False
@@ -424,7 +455,9 @@ class TouchdownCore:
         rep.F_contact = tal.P_vec * inv
         rep.F_n = tal.P_n * inv
         rep.P_n = tal.P_n
-        rep.F_n_peak = max(tal.peak, max((i.P_n * inv for i in tal.impacts), default=0.0))
+        rep.F_n_peak = tal.peak
+        for imp in tal.impacts:
+            rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
         rep.T_f = -self._p.R * tal.P_t * inv
         rep.E_diss = tal.E
         rep.mode = self._mode
@@ -736,4 +769,5 @@ class TouchdownCore:
         self._inputs = (float(W), complex(fx, fy), float(a))
         self._fm = FlightModel(self._p, *self._inputs)
         self._wf = WallForces.build(self._p, *self._inputs)
+        self._w_inputs = _input_rate(self._p, *self._inputs)
         self._clear = False
