@@ -22,6 +22,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import operator
 import os
 from typing import Any
 
@@ -111,6 +112,8 @@ REAL_PARAMETERS: tuple[tuple[str, float, str], ...] = (
                      "integrate_spin [s], > 0"),
 )
 TUNABLE: frozenset[str] = frozenset({"c", "k", "mu", "d", "e_c", "phi"})
+FIXED: tuple[str, ...] = (*(n for n, _s, _d in REAL_PARAMETERS if n not in TUNABLE),
+                          "levitate", "start_steady", "impact_log", "integrate_spin")
 CORE_PARAMS: tuple[str, ...] = ("m", "c", "k", "e_c", "phi", "c_r", "R", "mu", "d", "g")
 
 INPUTS: tuple[tuple[str, float, str], ...] = (
@@ -149,6 +152,10 @@ REAL_OUTPUTS: tuple[tuple[str, str], ...] = (
     ("Omega_out", "Spin speed at the end of the step: the integrated spin if "
                   "integrate_spin, else the input Omega [rad/s]"),
 )
+
+_get_fixed = operator.attrgetter(*FIXED)
+_get_tunables = operator.attrgetter(*sorted(TUNABLE))
+_get_inputs = operator.attrgetter(*(name for name, _s, _d in INPUTS))
 
 STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core-api.md)
 IMPACT_LOG_HEADER = "time,x,y,vx_minus,vy_minus,vx_plus,vy_plus,rdot,P_n,P_t,stick\n"
@@ -198,6 +205,10 @@ class RotorTouchdown(Fmi2Slave):
         self._t0 = 0.0
         self._failure = ""          # non-empty: the model is unusable, do_step refuses
         self._fixed_snapshot: dict[str, Any] = {}
+        # values the last step found valid: a step re-checks only what changed since
+        self._seen_fixed: tuple | None = None
+        self._seen_tunables: tuple | None = None
+        self._seen_inputs: tuple | None = None
         self._spin: Any = None      # rotortd_drive.SpinCoupler if integrate_spin
 
     # ------------------------------------------------------------------ declaration
@@ -295,6 +306,7 @@ class RotorTouchdown(Fmi2Slave):
         import rotortd  # resources/rotortd inside the FMU
 
         self._failure = ""
+        self._seen_fixed = self._seen_tunables = self._seen_inputs = None
         for name, _start, _desc in REAL_PARAMETERS:
             _check_finite(name, float(getattr(self, name)))
         self._check_inputs()
@@ -335,9 +347,7 @@ class RotorTouchdown(Fmi2Slave):
         return rotortd.RotorParams(levitate=bool(self.levitate), **kwargs)
 
     def _fixed_values(self) -> dict[str, Any]:
-        names = [n for n, _s, _d in REAL_PARAMETERS if n not in TUNABLE]
-        names += ["levitate", "start_steady", "impact_log", "integrate_spin"]
-        return {n: getattr(self, n) for n in names}
+        return dict(zip(FIXED, _get_fixed(self)))
 
     # ------------------------------------------------------------------ stepping
     def _input_values(self) -> tuple[float, complex, float]:
@@ -365,25 +375,38 @@ class RotorTouchdown(Fmi2Slave):
                 _check_finite(name, value)
             self._core.set_params(params.replace(**changes))
 
+    def _check_changes(self) -> None:
+        """Validate fixed parameters, tunables and inputs, each only when its values
+        differ from those the last step accepted (NaN never equals itself: re-checked)."""
+        fixed, tunables, inputs = _get_fixed(self), _get_tunables(self), _get_inputs(self)
+        if fixed != self._seen_fixed:
+            self._check_fixed()
+            self._seen_fixed = fixed
+        if inputs != self._seen_inputs:
+            self._check_inputs()
+            self._seen_inputs = inputs
+        if tunables != self._seen_tunables:
+            self._apply_tunables()
+            self._seen_tunables = tunables
+
     def _step(self, current_time: float, step_size: float) -> bool:
-        if self._core is None:
+        core = self._core
+        if core is None:
             raise ModelError("do_step before exitInitializationMode")
-        self._check_fixed()
-        self._check_inputs()
-        self._apply_tunables()
+        self._check_changes()
         if not step_size > 0.0:
             raise ModelError(f"communication step size {step_size!r} must be > 0")
-        if abs(current_time - self._core.t) > _time_tolerance(current_time, step_size):
+        if abs(current_time - core.t) > _time_tolerance(current_time, step_size):
             raise ModelError(f"communication point {current_time!r} does not match the "
-                             f"model time {self._core.t!r}")
-        omega, f_ext, amb = self._input_values()
-        t_target = self._core.t + step_size
+                             f"model time {core.t!r}")
+        omega, f_x, f_y, amb, t_drive = self._seen_inputs  # validated by _check_changes
+        omega, f_ext, amb = float(omega), complex(float(f_x), float(f_y)), float(amb)
+        t_target = core.t + step_size
         if self._spin is not None:
-            rep = self._spin.step(self._core, step_size, float(self.T_drive), F_ext=f_ext,
-                                  amb_on=amb)
+            rep = self._spin.step(core, step_size, float(t_drive), F_ext=f_ext, amb_on=amb)
             omega = self._spin.Omega
         else:
-            rep = self._core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
+            rep = core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
         self.Omega_out = omega
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
@@ -409,32 +432,25 @@ class RotorTouchdown(Fmi2Slave):
 
     # ------------------------------------------------------------------ publishing
     def _publish_kinematics(self, omega: float, amb: float) -> None:
-        kin = self._core.kinematics(omega, amb_on=amb)
-        for name in ("x", "y", "vx", "vy", "r_rel", "u_re", "u_im", "du_re", "du_im",
-                     "whirl_rate", "v_rel", "F_amb_x", "F_amb_y"):
-            setattr(self, name, float(getattr(kin, name)))
-        self.psi = float(kin.psi_wrapped)
+        (self.x, self.y, self.vx, self.vy, self.r_rel, self.u_re, self.u_im, self.du_re,
+         self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x,
+         self.F_amb_y) = self._core.kinematics(omega, amb_on=amb)
 
     def _publish_counters(self) -> None:
         core = self._core
-        self.mode = int(core.mode)
-        self.in_contact = self.mode != 0
-        self.n_impacts = int(core.n_impacts)
-        self.t_last_impact = float(core.t_last_impact)
-        v_last = float(core.v_last_impact)
-        self.v_last_impact = v_last if math.isfinite(v_last) else 0.0
-        self.E_diss = float(core.E_diss)
+        self.mode = core.mode
+        self.in_contact = core.mode != 0
+        self.n_impacts = core.n_impacts
+        self.t_last_impact = core.t_last_impact
+        self.v_last_impact = core.v_last_impact
+        self.E_diss = core.E_diss
 
     def _publish_step_outputs(self, rep: Any, n_step: int) -> None:
         if rep is None:
             self.F_bx = self.F_by = self.F_n = self.F_n_peak = self.P_n = self.T_f = 0.0
         else:
-            self.F_bx = float(rep.F_contact.real)
-            self.F_by = float(rep.F_contact.imag)
-            self.F_n = float(rep.F_n)
-            self.F_n_peak = float(rep.F_n_peak)
-            self.P_n = float(rep.P_n)
-            self.T_f = float(rep.T_f)
+            self.F_bx, self.F_by = rep.F_contact.real, rep.F_contact.imag
+            self.F_n, self.F_n_peak, self.P_n, self.T_f = rep.F_n, rep.F_n_peak, rep.P_n, rep.T_f
         self.n_impacts_step = n_step
 
     def _append_impacts(self, impacts: list[Any]) -> None:
@@ -497,6 +513,7 @@ class RotorTouchdown(Fmi2Slave):
         self._t0 = float(adapter["t0"])
         self._failure = str(adapter["failure"])
         self._fixed_snapshot = dict(adapter["fixed_snapshot"])
+        self._seen_fixed = self._seen_tunables = self._seen_inputs = None
         spin = adapter.get("spin")
         self._spin = None if spin is None else self._make_spin(float(spin))
 
