@@ -222,9 +222,10 @@ class Sliding:
             if u >= rem:
                 break
             step = min(H, rem - u)
+            cut = step < H  # cut short by the segment's end: accept from any column
             f0 = self.rhs(u, y)
             y_new, err, k, nfev = gbs.extrapolated_step(
-                self.rhs, u, y, f0, step, self.scale, k_min=K_MIN
+                self.rhs, u, y, f0, step, self.scale, k_min=2 if cut else K_MIN
             )
             tally.work += nfev
             if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
@@ -238,7 +239,8 @@ class Sliding:
             tally.peak = max(tally.peak, gn)
             u_next = u + step if step < rem - u else rem
             u, y = u_next, y_new
-            H = min(gbs.next_step_size(step, err, k), self.h_max)
+            if not cut:  # a cut step says nothing about the step the motion allows
+                H = min(gbs.next_step_size(step, err, k), self.h_max)
         else:
             raise ContactWorkExceeded("sliding segment exceeded its step cap", tally.work)
         self._tally(tally, y)

@@ -119,6 +119,8 @@ def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
     None when p < 0 on all of (0, tau]; otherwise a u > 0 with p < 0 on (0, u].
     """
     g0, g1, g2, g3 = _unit_scale(g0, g1, g2, g3)
+    if g0 < 0.0 and g0 + tau * (max(g1, 0.0) + tau * (0.5 * max(g2, 0.0) + tau * g3 / 6.0)) < 0:
+        return None  # p <= g0 + (its positive terms at tau) < 0: the common case, quickly
     if g0 == 0.0:
         return _safe_step_on_wall(g1, g2, g3, tau, work)
     knots = [0.0, *_critical_points(g1, g2, g3, tau), tau]

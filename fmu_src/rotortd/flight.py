@@ -23,14 +23,13 @@ from __future__ import annotations
 
 import cmath
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from .divdiff import dd2, dd3
 from .params import RotorParams
 
 
-@dataclass(frozen=True)
-class FlightCoeffs:
+class FlightCoeffs(NamedTuple):
     """Coefficients of the flight map over a fixed length ``s`` (s), inertial frame, SI.
 
     z(s) = p11 z0 + p12 v0 + f0 qz0 + F1 E0 qzs,   v(s) = p21 z0 + p22 v0 + f0 qv0 + F1 E0 qvs,
@@ -71,6 +70,8 @@ class FlightModel:
         self.F1 = p.e_c * self.Omega * self.Omega * cmath.exp(1j * p.phi)
         self.c_r = p.c_r
         self.l1, self.l2 = _eigenvalues(self.beta, self.kappa)
+        self.decay_rate = -max(self.l1.real, self.l2.real)
+        """Slowest decay rate of the transient (1/s); 0 without stiffness or damping."""
         self.K = self.kappa * p.c_r + abs(self.f0) + abs(self.F1)
         self.J = abs(self.Omega) * abs(self.F1)
         self.rate = max(abs(self.Omega), self.kappa**0.5, self.beta, (self.K / p.c_r) ** 0.5)
@@ -145,18 +146,24 @@ class FlightModel:
         (underdamped) or by e^{l1 t}(|zeta0| + |eta0 - mu zeta0| t) (any damping).
         Returns inf where no finite bound exists (kappa = 0, undamped resonance).
         """
+        steady, transient = self.radius_bound_parts(z0, v0, E0)
+        bound = steady + transient
+        return bound if bound == bound else math.inf  # NaN from inf - inf: no bound
+
+    def radius_bound_parts(self, z0: complex, v0: complex, E0: complex) -> tuple[float, float]:
+        """(|Z0| + |Z1|, bound of the transient) (m), the two terms of sup_radius_bound;
+        (inf, inf) where no finite bound exists."""
         kap, beta, W = self.kappa, self.beta, self.Omega
         if kap <= 0.0:
-            return math.inf
+            return math.inf, math.inf
         den = complex(kap - W * W, beta * W)
         if den == 0:
-            return math.inf
+            return math.inf, math.inf
         Z0 = self.f0 / kap
         Z1 = self.F1 * E0 / den
         zeta = z0 - Z0 - Z1
         eta = v0 - 1j * W * Z1
-        bound = abs(Z0) + abs(Z1) + _transient_bound(beta, kap, zeta, eta)
-        return bound if bound == bound else math.inf  # NaN from inf - inf: no bound
+        return abs(Z0) + abs(Z1), _transient_bound(beta, kap, zeta, eta)
 
 
 def _eigenvalues(beta: float, kappa: float) -> tuple[complex, complex]:

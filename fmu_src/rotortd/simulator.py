@@ -206,7 +206,7 @@ class TouchdownCore:
         self._slip = 0.0
         self._locked = False
         self._on_wall = abs(z0) >= params.c_r * (1.0 - 1e-15)
-        self._clear = False
+        self._unclear()
         self._roll_lenient = False  # in a step: zero slip proved stuck (_transition)
         self._sticky_at = math.nan  # in a step: where flight and contact swapped at N = 0
         self._n_impacts = 0
@@ -291,7 +291,7 @@ class TouchdownCore:
         self._p = params
         self._fm = None
         self._wf = None
-        self._clear = False
+        self._unclear()
         self._locked = False
 
     @property
@@ -446,7 +446,7 @@ class TouchdownCore:
             self._w_inputs = _input_rate(self._p, W, F, a)
             self._fm = FlightModel(self._p, W, F, a)
             self._wf = WallForces.build(self._p, W, F, a)
-            self._clear = False
+            self._unclear()
             self._locked = False
 
     def _fill_report(self, rep: StepReport, tal: _Tally, work: Work, h: float) -> None:
@@ -488,9 +488,9 @@ class TouchdownCore:
         assert fm is not None
         rem = h - s
         E = self._phasor()
-        if not self._clear:
+        if not self._clear and t0 + s >= self._envelope_at:
             work.evals += 1
-            self._clear = fm.sup_radius_bound(self._z, self._v, E) < self._p.c_r * _R_CLEAR
+            self._check_envelope(fm, t0 + s, E)
         hit = None
         if not self._clear:
             hit = ContactLocator(fm, self._z, self._v, E).find(rem, self._on_wall, work)
@@ -507,13 +507,33 @@ class TouchdownCore:
             self._on_wall = False
             return s + ds
         z = hit.z * (self._p.c_r / abs(hit.z))
-        self._clear = False
+        self._unclear()
         if hit.kind == "impact":
             self._impact(t0 + s + ds, z, hit.v, tally)
         else:
             self._z, self._v = z, hit.v
             self._enter_contact()
         return s + ds if ds > 0.0 else s + 0.0
+
+    def _check_envelope(self, fm: FlightModel, t: float, E: complex) -> None:
+        """Try to prove the flight clear of the wall for all time under the held inputs
+        (``_clear``). If that fails, schedule the next try for when the transient bound,
+        decaying like e^{-decay_rate t}, could have fallen below the margin left by the
+        steady whirl; never, if the steady whirl alone reaches the wall. The schedule only
+        saves work: a flight that is not proved clear is searched, which is always exact."""
+        steady, transient = fm.radius_bound_parts(self._z, self._v, E)
+        limit = self._p.c_r * _R_CLEAR
+        if steady + transient < limit:
+            self._clear = True
+        elif steady < limit and fm.decay_rate > 0.0 and math.isfinite(transient):
+            self._envelope_at = t + math.log(transient / (limit - steady)) / fm.decay_rate
+        else:
+            self._envelope_at = math.inf
+
+    def _unclear(self) -> None:
+        """Forget the envelope proof: the state jumped or the inputs changed."""
+        self._clear = False
+        self._envelope_at = -math.inf
 
     def _impact(self, t: float, z: complex, v_minus: complex, tally: _Tally) -> None:
         p = self._p
@@ -673,7 +693,7 @@ class TouchdownCore:
         self._mode = MODE_FREE
         self._on_wall = True
         self._locked = False
-        self._clear = False
+        self._unclear()
 
     def _try_lock(self, E: complex) -> bool:
         """True when the state sits on a stable forward-rub equilibrium (then lock it)."""
@@ -770,4 +790,4 @@ class TouchdownCore:
         self._fm = FlightModel(self._p, *self._inputs)
         self._wf = WallForces.build(self._p, *self._inputs)
         self._w_inputs = _input_rate(self._p, *self._inputs)
-        self._clear = False
+        self._unclear()
