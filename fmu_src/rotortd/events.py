@@ -31,7 +31,7 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from .flight import FlightModel
+from .flight import FlightModel, Modes
 
 EPS = 2.220446049250313e-16
 TOL_G_ULPS = 64.0
@@ -187,10 +187,18 @@ class ContactLocator:
         self.tol_g = TOL_G_ULPS * EPS * self.c2
         w = max(fm.rate, abs(v0) / fm.c_r)
         self.horizon = HORIZON / w if w > 0.0 else math.inf
+        self._modes: Modes | None = None  # built on the first state() call
+        self._modes_built = False
 
     def state(self, s: float, work: Work) -> tuple[complex, complex, complex]:
-        """Exact (z, v, E) at local time s, from the flight's start (no drift)."""
+        """Exact (z, v, E) at local time s, from the flight's start (no drift): by modes
+        when they are well conditioned, else by the divided-difference flight map."""
         work.evals += 1
+        if not self._modes_built:
+            self._modes, self._modes_built = self.fm.modes(self.z0, self.v0, self.E0), True
+        if self._modes is not None:
+            z, v, rot = self._modes.at(s)
+            return z, v, self.E0 * rot
         z, v = self.fm.propagate(self.z0, self.v0, self.E0, s)
         return z, v, self.E0 * cmath.exp(1j * self.fm.Omega * s)
 

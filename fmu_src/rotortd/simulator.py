@@ -165,7 +165,8 @@ def _input_rate(p: RotorParams, Omega: float, F_ext: complex, amb: float) -> flo
 
 
 def _cap(h: float, w_inputs: float, w_speed: float) -> int:
-    return int(WORK_BASE + WORK_PER_RADIAN * min(h * max(w_inputs, w_speed), 1e12))
+    x = h * (w_inputs if w_inputs > w_speed else w_speed)  # radians of the fastest rate
+    return int(WORK_BASE + WORK_PER_RADIAN * (x if x < 1e12 else 1e12))
 
 
 class TouchdownCore:
@@ -350,31 +351,26 @@ class TouchdownCore:
 
     def kinematics(self, Omega: float | None = None, amb_on: float | None = None) -> Kinematics:
         """Derived outputs at the current state, for the given (or last) inputs."""
-        W = self._inputs[0] if Omega is None else float(Omega)
-        a = self._inputs[2] if amb_on is None else float(amb_on)
-        p, z, v = self._p, self._z, self._v
-        rot = cmath.exp(-1j * self._psi)
-        U = z * rot / p.c_r
-        dU = (v - 1j * W * z) * rot / (p.c_r * W) if W != 0.0 else 0j
-        r2 = abs(z) ** 2
-        whirl = (z.conjugate() * v).imag / r2 if r2 > 0.0 else 0.0
+        return Kinematics._make(self.kinematics_values(Omega, amb_on))
+
+    def kinematics_values(
+        self, Omega: float | None = None, amb_on: float | None = None
+    ) -> tuple[float, ...]:
+        """The fields of ``kinematics`` as a plain tuple, in the same order (cheaper)."""
+        W = self._inputs[0] if Omega is None else Omega
+        a = self._inputs[2] if amb_on is None else amb_on
+        p, z, v, psi = self._p, self._z, self._v, self._psi
+        c_r = p.c_r
+        rot = cmath.exp(-1j * psi)
+        zr = z * rot
+        r = abs(z)
+        whirl = (z.real * v.imag - z.imag * v.real) / (r * r) if r > 0.0 else 0.0
+        dU = (v - 1j * W * z) * rot / (c_r * W) if W != 0.0 else 0j
         F_amb = a * (p.bias_force - p.c * v - p.k * z)
-        psi_w = -self._psi if self._psi == -math.pi else self._psi
-        return Kinematics(
-            z.real,
-            z.imag,
-            v.real,
-            v.imag,
-            abs(z) / p.c_r,
-            U.real,
-            U.imag,
-            dU.real,
-            dU.imag,
-            psi_w,
-            whirl,
-            p.R * W + p.c_r * whirl,
-            F_amb.real,
-            F_amb.imag,
+        return (
+            z.real, z.imag, v.real, v.imag, r / c_r, zr.real / c_r, zr.imag / c_r,
+            dU.real, dU.imag, -psi if psi == -math.pi else psi, whirl,
+            p.R * W + c_r * whirl, F_amb.real, F_amb.imag,
         )
 
     # ------------------------------------------------------------------ stepping
