@@ -205,7 +205,10 @@ class RotorTouchdown(Fmi2Slave):
         self._t0 = 0.0
         self._failure = ""          # non-empty: the model is unusable, do_step refuses
         self._fixed_snapshot: dict[str, Any] = {}
-        # values the last step found valid: a step re-checks only what changed since
+        # values the last step found valid: a step re-checks only what changed since,
+        # and nothing unless an FMI setter (or initialisation, or a state restore) ran
+        self._changed = True
+        self._step_inputs: tuple[float, complex, float, float] = (0.0, 0j, 1.0, 0.0)
         self._seen_fixed: tuple | None = None
         self._seen_tunables: tuple | None = None
         self._seen_inputs: tuple | None = None
@@ -217,34 +220,40 @@ class RotorTouchdown(Fmi2Slave):
             setattr(self, name, start)
             var = Fmi2Variability.tunable if name in TUNABLE else Fmi2Variability.fixed
             self.register_variable(Real(name, causality=Fmi2Causality.parameter,
-                                        variability=var, description=desc))
+                                        variability=var, description=desc,
+                                        setter=self._watched_setter(name)))
         self.levitate = True
         self.register_variable(Boolean(
             "levitate", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-            description="AMB bias force +i m g holds the rotor centred against gravity [-]"))
+            description="AMB bias force +i m g holds the rotor centred against gravity [-]",
+            setter=self._watched_setter("levitate")))
         self.start_steady = False
         self.register_variable(Boolean(
             "start_steady", causality=Fmi2Causality.parameter,
             variability=Fmi2Variability.fixed,
             description="Start on the steady free whirl (error if not admissible) [-]; "
-                        "overrides x0, y0, vx0, vy0"))
+                        "overrides x0, y0, vx0, vy0",
+            setter=self._watched_setter("start_steady")))
         self.integrate_spin = False
         self.register_variable(Boolean(
             "integrate_spin", causality=Fmi2Causality.parameter,
             variability=Fmi2Variability.fixed,
             description="Integrate the spin inside the FMU: J Omega' = T_drive + T_f, "
                         "sub-stepped at h_spin; the input Omega is then only the initial "
-                        "speed and Omega_out the spin [-]"))
+                        "speed and Omega_out the spin [-]",
+            setter=self._watched_setter("integrate_spin")))
         self.impact_log = ""
         self.register_variable(String(
             "impact_log", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description="If not empty: CSV path; every impact is appended (time, x, y, vx-, "
-                        "vy-, vx+, vy+, rdot, P_n, P_t, stick) [-]"))
+                        "vy-, vx+, vy+, rdot, P_n, P_t, stick) [-]",
+            setter=self._watched_setter("impact_log")))
 
     def _declare_inputs(self) -> None:
         for name, start, desc in INPUTS:
             setattr(self, name, start)
-            self.register_variable(Real(name, causality=Fmi2Causality.input, description=desc))
+            self.register_variable(Real(name, causality=Fmi2Causality.input, description=desc,
+                                        setter=self._watched_setter(name)))
 
     def _declare_outputs(self) -> None:
         exact = Fmi2Initial.exact
@@ -268,6 +277,14 @@ class RotorTouchdown(Fmi2Slave):
             "in_contact", causality=Fmi2Causality.output, variability=discrete, initial=exact,
             description="Rotor in sustained contact (mode != 0) at the end of the step [-]",
             setter=self._output_setter("in_contact")))
+
+    def _watched_setter(self, name: str) -> Any:
+        """FMI setter of a parameter or input: stores the value and marks the values as
+        changed, so the next step validates them (and only then)."""
+        def store(value: Any) -> None:
+            setattr(self, name, value)
+            self._changed = True
+        return store
 
     def _output_setter(self, name: str) -> Any:
         def refuse(_value: Any) -> None:
@@ -307,6 +324,7 @@ class RotorTouchdown(Fmi2Slave):
 
         self._failure = ""
         self._seen_fixed = self._seen_tunables = self._seen_inputs = None
+        self._changed = True
         for name, _start, _desc in REAL_PARAMETERS:
             _check_finite(name, float(getattr(self, name)))
         self._check_inputs()
@@ -385,6 +403,9 @@ class RotorTouchdown(Fmi2Slave):
         if inputs != self._seen_inputs:
             self._check_inputs()
             self._seen_inputs = inputs
+            omega, f_x, f_y, amb, t_drive = inputs
+            self._step_inputs = (float(omega), complex(float(f_x), float(f_y)), float(amb),
+                                 float(t_drive))
         if tunables != self._seen_tunables:
             self._apply_tunables()
             self._seen_tunables = tunables
@@ -393,17 +414,19 @@ class RotorTouchdown(Fmi2Slave):
         core = self._core
         if core is None:
             raise ModelError("do_step before exitInitializationMode")
-        self._check_changes()
+        if self._changed:
+            self._check_changes()
+            self._changed = False
         if not step_size > 0.0:
             raise ModelError(f"communication step size {step_size!r} must be > 0")
-        if abs(current_time - core.t) > _time_tolerance(current_time, step_size):
+        tol = _time_tolerance(current_time, step_size)
+        if abs(current_time - core.t) > tol:
             raise ModelError(f"communication point {current_time!r} does not match the "
                              f"model time {core.t!r}")
-        omega, f_x, f_y, amb, t_drive = self._seen_inputs  # validated by _check_changes
-        omega, f_ext, amb = float(omega), complex(float(f_x), float(f_y)), float(amb)
+        omega, f_ext, amb, t_drive = self._step_inputs  # validated by _check_changes
         t_target = core.t + step_size
         if self._spin is not None:
-            rep = self._spin.step(core, step_size, float(t_drive), F_ext=f_ext, amb_on=amb)
+            rep = self._spin.step(core, step_size, t_drive, F_ext=f_ext, amb_on=amb)
             omega = self._spin.Omega
         else:
             rep = core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
@@ -411,16 +434,17 @@ class RotorTouchdown(Fmi2Slave):
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         self._publish_kinematics(omega, amb)
-        self._publish_counters()
+        if rep.impacts or rep.transitions or rep.E_diss:  # else the counters stand
+            self._publish_counters()
         self._publish_step_outputs(rep, len(rep.impacts))
-        return self._judge_report(rep, t_target, step_size)
+        return self._judge_report(rep, t_target, tol)
 
-    def _judge_report(self, rep: Any, t_target: float, step_size: float) -> bool:
+    def _judge_report(self, rep: Any, t_target: float, tol: float) -> bool:
         """A step the core could not finish (work cap) is refused: the outputs show the
         state where it stopped and the model time stays there (restore a saved FMU state or
         continue from core time). A completed step with a non-OK status is a warning."""
         reached = self._core.t
-        short = abs(reached - t_target) > _time_tolerance(t_target, step_size)
+        short = abs(reached - t_target) > tol
         if rep.status == STATUS_WORK_CAP or short:
             self.log(f"step incomplete: core status {rep.status} ({rep.message}); model time "
                      f"stays at t={reached!r} instead of {t_target!r}", Fmi2Status.error)
@@ -434,7 +458,7 @@ class RotorTouchdown(Fmi2Slave):
     def _publish_kinematics(self, omega: float, amb: float) -> None:
         (self.x, self.y, self.vx, self.vy, self.r_rel, self.u_re, self.u_im, self.du_re,
          self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x,
-         self.F_amb_y) = self._core.kinematics(omega, amb_on=amb)
+         self.F_amb_y) = self._core.kinematics_values(omega, amb)
 
     def _publish_counters(self) -> None:
         core = self._core
@@ -514,6 +538,7 @@ class RotorTouchdown(Fmi2Slave):
         self._failure = str(adapter["failure"])
         self._fixed_snapshot = dict(adapter["fixed_snapshot"])
         self._seen_fixed = self._seen_tunables = self._seen_inputs = None
+        self._changed = True
         spin = adapter.get("spin")
         self._spin = None if spin is None else self._make_spin(float(spin))
 
