@@ -42,6 +42,10 @@ G2_FLOOR = 1024.0 * TINY
 """Absolute part of the rounding bands of g' and g'' (m^2/s, m^2/s^2): with subnormal
 forces or speeds their relative bands vanish, but the products in g' and g'' still carry
 an absolute error of a few TINY, enough to flip a sign (fuzzing: a 1e-313 N force)."""
+BRACKET_RTOL = 1e-6
+"""Relative width at which the bracket of the cubic's first root stops (its left end is
+returned). Any point left of the root is a safe step; near a contact the next advance
+starts 1e-6 of a step short of the root and closes the rest with the cubic's own accuracy."""
 HORIZON = 0.25
 """Longest interval (in units of 1/w, w the flight's fastest rate) one cubic bound covers:
 the bound of g''' grows with the interval, so a longer one only shortens the safe step."""
@@ -158,7 +162,7 @@ def _bracket_left(f, lo: float, hi: float, work: Work) -> float:
     side = 0
     for _ in range(100):
         work.iters += 1
-        if hi - lo <= 4.0 * EPS * hi:
+        if hi - lo <= BRACKET_RTOL * hi:
             break
         x = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
         if not lo < x < hi:
