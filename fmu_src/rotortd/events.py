@@ -259,11 +259,12 @@ class ContactLocator:
             g1 = 2.0 * (z.conjugate() * v).real
             g2 = 2.0 * (v * v.conjugate()).real + 2.0 * (z.conjugate() * acc).real
             if g >= -self.tol_g or (wall and s == 0.0):
-                hit = self._at_wall(s, z, v, E, g, g1, g2, work, first=(s == 0.0))
+                bands = self.bands(v)
+                hit = self._at_wall(s, z, v, E, g, g1, g2, bands, work, first=(s == 0.0))
                 if hit is not None:
                     return hit
                 g, g1 = 0.0, min(g1, 0.0)
-                tol_g1, tol_g2 = self.bands(v)
+                tol_g1, tol_g2 = bands
                 if g1 >= -tol_g1 and g2 >= -tol_g2 and s < h:  # tangential departure
                     s = min(h, s + self.grace_step(z, v, E))
                     z, v, E = self.state(s, work)
@@ -308,11 +309,13 @@ class ContactLocator:
         g: float,
         g1: float,
         g2: float,
+        bands: tuple[float, float],
         work: Work,
         first: bool,
     ) -> Contact | None:
-        """Classify a point at the wall: impact, touch, or None (leaving / grazing by)."""
-        tol_g1, tol_g2 = self.bands(v)
+        """Classify a point at the wall: impact, touch, or None (leaving / grazing by).
+        ``bands``: the rounding bands of g' and g'' there (``bands(v)``)."""
+        tol_g1, tol_g2 = bands
         outward = g1 > tol_g1
         if outward and g2 < 0.0:
             outward = g + g1 * g1 / (-2.0 * g2) > self.tol_g  # resolvable excursion
