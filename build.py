@@ -8,10 +8,12 @@ post-processed (units with <UnitDefinitions>, min/max of bounded variables, a co
 <ModelStructure>, capability flags) and documentation/index.html is added. Finally the FMU is
 validated with fmpy and `fmutool -check`; the script exits non-zero on any problem.
 
-To add an FMU (e.g. Drivetrain), append an FmuSpec to FMU_SPECS: its script must define a
-``VARIABLE_META`` dict {name: (unit, min, max)} next to the Fmi2Slave class, declare the class
-as ``class Name(Fmi2Slave):`` (PythonFMU finds it by that regex), and use a script name and
-package names of its own: every PythonFMU instance in a process shares ``sys.modules``.
+To add an FMU (e.g. Drivetrain), write its adapter as a module of ``rotortd_fmi`` with a
+``VARIABLE_META`` dict {name: (unit, min, max)}, and a few-line script in fmu_src/ that
+subclasses the adapter and re-exports ``VARIABLE_META`` (PythonFMU 0.7 compiles the script on
+every fmi2Instantiate, and takes the Fmi2Slave subclass with the longest MRO); then append an
+FmuSpec to FMU_SPECS. Script and package names must be the project's own: every PythonFMU
+instance in a process shares ``sys.modules``.
 """
 
 from __future__ import annotations
@@ -126,7 +128,8 @@ FMU_SPECS: tuple[FmuSpec, ...] = (
     FmuSpec(
         name="RotorTouchdown",
         script=Path("fmu_src/RotorTouchdown.py"),
-        project_dirs=(Path("fmu_src/rotortd"), Path("fmu_src/rotortd_drive")),
+        project_dirs=(Path("fmu_src/rotortd"), Path("fmu_src/rotortd_drive"),
+                      Path("fmu_src/rotortd_fmi")),
         options={"canHandleVariableCommunicationStepSize": True,
                  "canGetAndSetFMUstate": True, "canSerializeFMUstate": True},
         equations_html=ROTOR_EQUATIONS,
@@ -134,7 +137,7 @@ FMU_SPECS: tuple[FmuSpec, ...] = (
     FmuSpec(
         name="Drivetrain",
         script=Path("fmu_src/Drivetrain.py"),
-        project_dirs=(Path("fmu_src/rotortd_drive"),),
+        project_dirs=(Path("fmu_src/rotortd_drive"), Path("fmu_src/rotortd_fmi")),
         options={"canHandleVariableCommunicationStepSize": True,
                  "canGetAndSetFMUstate": True, "canSerializeFMUstate": True},
         equations_html=DRIVE_EQUATIONS,
@@ -142,6 +145,7 @@ FMU_SPECS: tuple[FmuSpec, ...] = (
     FmuSpec(
         name="TouchdownEvents",
         script=Path("fmu_src/TouchdownEvents.py"),
+        project_dirs=(Path("fmu_src/rotortd_fmi"),),
         options={"canHandleVariableCommunicationStepSize": True},
         equations_html=EVENTS_EQUATIONS,
     ),

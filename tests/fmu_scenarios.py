@@ -9,6 +9,7 @@ down, and the exit-time teardown cannot turn a finished scenario into a failure.
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import os
@@ -294,9 +295,12 @@ def sc_cycles(fmu: str, n_cycles: int, steps: int) -> dict[str, Any]:
     finals = []
     for i in range(n_cycles):
         inst = Instance(fmu, f"cycle{i}", unzipdir=unzipdir)
+        gc.collect()  # PythonFMU keeps the script's namespace alive only through its functions
         inst.init({})
+        gc.collect()
         finals.append(_run(inst, steps, 1e-4)[-1]["x"])
         inst.free()
+        gc.collect()
     shutil.rmtree(unzipdir, ignore_errors=True)
     return {"cycles": len(finals), "all_equal": len(set(finals)) == 1}
 

@@ -29,7 +29,6 @@ from __future__ import annotations
 import argparse
 import ast
 import cmath
-import importlib.util
 import json
 import math
 import multiprocessing as mproc
@@ -295,7 +294,11 @@ def run_direct(sc: Scene, method: str, rtol: float) -> RunResult:
 
 
 # --------------------------------------------------------------------------- FMUs
-FLOOR_TEMPLATE = '''"""Overhead floor: RotorTouchdown's variables, a do_step that does nothing."""
+FLOOR_TEMPLATE = '''"""Overhead floor: RotorTouchdown's variables, a do_step that does nothing.
+
+Packaged like RotorTouchdown: this module is resources/rotortd_floor/slave.py, and the FMU
+script (FLOOR_SCRIPT) only subclasses it, since PythonFMU compiles the script per instance.
+"""
 
 from pythonfmu import Boolean, Fmi2Slave, Integer, Real, String
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
@@ -307,7 +310,7 @@ INPUTS = {inputs!r}
 REAL_OUTPUTS = {outputs!r}
 
 
-class RotorTouchdownFloor(Fmi2Slave):
+class RotorTouchdownFloorAdapter(Fmi2Slave):
     """Same names and causalities as RotorTouchdown; do_step returns True."""
 
     def __init__(self, **kwargs):
@@ -341,13 +344,22 @@ class RotorTouchdownFloor(Fmi2Slave):
         return True
 '''
 
+FLOOR_SCRIPT = '''"""FMU script of the overhead floor (see rotortd_floor/slave.py)."""
+
+from rotortd_floor import slave as _adapter
+
+VARIABLE_META = _adapter.VARIABLE_META
+
+
+class RotorTouchdownFloor(_adapter.RotorTouchdownFloorAdapter):
+    def __init__(self, **kwargs):  # keeps PythonFMU's namespace of this script alive
+        super().__init__(**kwargs)
+'''
+
 
 def _adapter_tables() -> dict[str, Any]:
-    path = ROOT / "fmu_src" / "RotorTouchdown.py"
-    spec = importlib.util.spec_from_file_location("_bench_adapter_tables", path)
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    from rotortd_fmi import touchdown as mod
+
     return {"meta": mod.VARIABLE_META, "params": mod.REAL_PARAMETERS,
             "tunable": set(mod.TUNABLE), "inputs": mod.INPUTS, "outputs": mod.REAL_OUTPUTS}
 
@@ -356,10 +368,14 @@ def build_fmus(tmp: Path) -> dict[str, tuple[str, Any]]:
     """Build RotorTouchdown and the floor FMU into tmp; return name -> (unzipdir, md)."""
     from fmpy import extract, read_model_description
 
+    floor_pkg = tmp / "rotortd_floor"
+    floor_pkg.mkdir()
+    (floor_pkg / "__init__.py").write_text("")
+    (floor_pkg / "slave.py").write_text(FLOOR_TEMPLATE.format(**_adapter_tables()))
     floor_script = tmp / "RotorTouchdownFloor.py"
-    floor_script.write_text(FLOOR_TEMPLATE.format(**_adapter_tables()))
-    specs = [build.FMU_SPECS[0], build.FmuSpec(name="RotorTouchdownFloor",
-                                                script=floor_script)]
+    floor_script.write_text(FLOOR_SCRIPT)
+    specs = [build.FMU_SPECS[0], build.FmuSpec(name="RotorTouchdownFloor", script=floor_script,
+                                                project_dirs=(floor_pkg,))]
     out = {}
     for spec in specs:
         fmu = build.build_fmu(spec, tmp / "fmus")

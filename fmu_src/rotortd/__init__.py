@@ -2,7 +2,7 @@
 
 Pure Python on ``math``/``cmath`` (no numpy, no pythonfmu), so it is fast for scalar
 work and safe inside any FMI host. SI units and the inertial frame unless stated.
-The FMU (``fmu_src/RotorTouchdown.py``) is a thin adapter over ``TouchdownCore``.
+The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``TouchdownCore``.
 """
 
 from .contact import RubEquilibrium, WallForces, forward_rub_equilibria

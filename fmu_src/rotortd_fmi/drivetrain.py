@@ -1,0 +1,241 @@
+"""PythonFMU adapter of the FMU Drivetrain: ``J Omega' = T_motor - b Omega + T_bearing``.
+
+The FMU's script ``fmu_src/Drivetrain.py`` only subclasses ``DrivetrainAdapter``.
+
+The motor is a held torque input (``motor = 0``) or a PI speed controller with set-point
+``Omega_set`` and torque limit ``T_max`` (``motor = 1``). The physics lives in the
+pure-Python package ``rotortd_drive`` (shipped as ``resources/rotortd_drive``), which
+advances the drivetrain exactly for inputs held over a communication step.
+
+Connect ``Omega`` to ``RotorTouchdown.Omega`` and ``RotorTouchdown.T_f`` to ``T_bearing``.
+With ``follow_speed`` the drivetrain does not integrate its inertia: ``Omega`` follows the
+input ``Omega_in`` (e.g. ``RotorTouchdown.Omega_out`` with ``integrate_spin``) and
+``T_drive`` (motor plus drag, step-averaged) goes to ``RotorTouchdown.T_drive``.
+
+Cumulative angular impulses ``H_motor``, ``H_drag``, ``H_bearing`` [N m s] close the
+momentum balance ``J (Omega - Omega0) = H_motor + H_drag + H_bearing`` to round-off.
+Errors are logged (fmi2Error) and the step returns fmi2Discard; nothing escapes into the
+C wrapper. Only the standard library and ``rotortd_drive`` are imported at run time.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+from pythonfmu import Boolean, DefaultExperiment, Fmi2Slave, Integer, Real
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+
+STATE_SCHEMA = "rotortd-drivetrain-fmu-state"
+
+VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
+    "J": ("kg.m2", 0.0, None),
+    "b": ("N.m.s", 0.0, None),
+    "Kp": ("N.m.s", 0.0, None),
+    "Ki": ("N.m", 0.0, None),
+    "T_max": ("N.m", 0.0, None),
+    "Omega0": ("rad/s", None, None),
+    "psi0": ("rad", None, None),
+    "T_bearing": ("N.m", None, None),
+    "T_motor_in": ("N.m", None, None),
+    "Omega_set": ("rad/s", None, None),
+    "Omega_in": ("rad/s", None, None),
+    "Omega": ("rad/s", None, None),
+    "psi": ("rad", None, None),
+    "T_motor": ("N.m", None, None),
+    "T_drag": ("N.m", None, None),
+    "T_drive": ("N.m", None, None),
+    "pi_integral": ("rad", None, None),
+    "H_motor": ("N.m.s", None, None),
+    "H_drag": ("N.m.s", None, None),
+    "H_bearing": ("N.m.s", None, None),
+    "motor": ("", 0, 1),
+    "pi_regime": ("", 0, 2),
+}
+
+FIXED = ("J", "Omega0", "psi0")
+TUNABLE = ("b", "Kp", "Ki", "T_max")
+PARAMETERS: tuple[tuple[str, float, str], ...] = (
+    ("J", 0.04, "Polar inertia of rotor and drive [kg.m2], > 0"),
+    ("Omega0", 184.2, "Initial spin speed [rad/s], finite"),
+    ("psi0", 0.0, "Initial spin angle [rad], finite"),
+    ("b", 1e-4, "Viscous drag coefficient [N.m.s], >= 0; tunable"),
+    ("Kp", 0.2, "PI proportional gain [N.m.s], >= 0; tunable"),
+    ("Ki", 2.0, "PI integral gain [N.m], >= 0; tunable"),
+    ("T_max", 5.0, "PI torque limit |T_motor| <= T_max [N.m], > 0; tunable"),
+)
+INPUTS: tuple[tuple[str, float, str], ...] = (
+    ("T_bearing", 0.0, "Torque from the bearing (RotorTouchdown.T_f), held over the step "
+                       "[N.m]"),
+    ("T_motor_in", 0.0, "Motor torque if motor = 0 (torque input), held [N.m]"),
+    ("Omega_set", 184.2, "Speed set-point of the PI controller (motor = 1) [rad/s]"),
+    ("Omega_in", 0.0, "Spin speed imposed from outside if follow_speed [rad/s]"),
+)
+OUTPUTS: tuple[tuple[str, str], ...] = (
+    ("Omega", "Spin speed at the end of the step [rad/s]"),
+    ("psi", "Spin angle wrapped to (-pi, pi] [rad]"),
+    ("T_motor", "Motor torque averaged over the step [N.m]"),
+    ("T_drag", "Drag torque -b Omega averaged over the step [N.m]"),
+    ("T_drive", "T_motor + T_drag averaged over the step (to RotorTouchdown.T_drive) [N.m]"),
+    ("pi_integral", "PI integrator state, integral of Omega_set - Omega [rad]"),
+    ("H_motor", "Angular impulse of the motor since the start, cumulative [N.m.s]"),
+    ("H_drag", "Angular impulse of the drag since the start, cumulative [N.m.s]"),
+    ("H_bearing", "Angular impulse of T_bearing since the start, cumulative [N.m.s]"),
+)
+
+
+def _wrap(angle: float) -> float:
+    """Angle wrapped to (-pi, pi] [rad]."""
+    w = math.remainder(angle, 2.0 * math.pi)
+    return math.pi if w == -math.pi else w
+
+
+class DrivetrainAdapter(Fmi2Slave):
+    """Drivetrain J Omega' = T_motor - b Omega + T_bearing; torque motor or limited PI."""
+
+    author = "rotor-touchdown project"
+    description = ("Drivetrain of the rotor: inertia, drag, torque motor or PI speed "
+                   "controller with torque limit; exact for inputs held over a step.")
+    version = "0.1.0"
+    license = "MIT"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-4)
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self._declare()
+        self._core: Any = None
+        self._failure = ""
+        self._fixed: dict[str, Any] = {}
+
+    # ------------------------------------------------------------------ declaration
+    def _declare(self) -> None:
+        for name, start, desc in PARAMETERS:
+            setattr(self, name, start)
+            var = Fmi2Variability.tunable if name in TUNABLE else Fmi2Variability.fixed
+            self.register_variable(Real(name, causality=Fmi2Causality.parameter,
+                                        variability=var, description=desc))
+        self.motor = 0
+        self.register_variable(Integer(
+            "motor", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description="Motor model: 0 torque input T_motor_in, 1 PI speed controller [-]"))
+        self.follow_speed = False
+        self.register_variable(Boolean(
+            "follow_speed", causality=Fmi2Causality.parameter,
+            variability=Fmi2Variability.fixed,
+            description="Omega follows the input Omega_in (the spin is integrated "
+                        "elsewhere, e.g. RotorTouchdown with integrate_spin) [-]"))
+        for name, start, desc in INPUTS:
+            setattr(self, name, start)
+            self.register_variable(Real(name, causality=Fmi2Causality.input, description=desc))
+        for name, desc in OUTPUTS:
+            setattr(self, name, 0.0)
+            getter = self._omega_getter if name == "Omega" else None
+            self.register_variable(Real(name, causality=Fmi2Causality.output,
+                                        initial=Fmi2Initial.exact, description=desc,
+                                        getter=getter))
+        self.pi_regime = 0
+        self.register_variable(Integer(
+            "pi_regime", causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
+            initial=Fmi2Initial.exact,
+            description="PI regime at the end of the step: 0 linear, 1 saturated, 2 on the "
+                        "limit with the integrator following it [-]"))
+
+    def _omega_getter(self) -> float:
+        """Omega: the state once initialised, before that the start value (hosts that
+        propagate outputs during initialisation then see the right speed)."""
+        if self._core is not None:
+            return float(self._core.Omega)
+        return float(self.Omega_in if self.follow_speed else self.Omega0)
+
+    # ------------------------------------------------------------------ FMI calls
+    def exit_initialization_mode(self) -> bool:
+        try:
+            self._initialise()
+            return True
+        except Exception as exc:
+            self._fail(f"initialisation failed: {exc}")
+            return False
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._failure:
+            self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
+            return False
+        try:
+            self._step(current_time, step_size)
+            return True
+        except Exception as exc:
+            self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
+            return False
+
+    def _fail(self, msg: str) -> None:
+        self._failure = msg
+        self.log(msg, Fmi2Status.error)
+
+    # ------------------------------------------------------------------ model
+    def _params(self) -> Any:
+        from rotortd_drive import DriveParams
+
+        kw = {n: float(getattr(self, n)) for n in ("J", *TUNABLE)}
+        return DriveParams(motor=int(self.motor), **kw).validate()
+
+    def _initialise(self) -> None:
+        from rotortd_drive import DriveCore
+
+        for name, _s, _d in PARAMETERS + INPUTS:
+            if not math.isfinite(float(getattr(self, name))):
+                raise ValueError(f"{name}={getattr(self, name)!r} is not finite")
+        omega0 = float(self.Omega_in) if self.follow_speed else float(self.Omega0)
+        self._core = DriveCore(self._params(), omega0, psi0=float(self.psi0))
+        self._fixed = {n: getattr(self, n) for n in (*FIXED, "motor", "follow_speed")}
+        self._publish(None)
+
+    def _step(self, current_time: float, step_size: float) -> None:
+        core = self._core
+        if core is None:
+            raise ValueError("do_step before exitInitializationMode")
+        for name, value in self._fixed.items():
+            if getattr(self, name) != value:
+                raise ValueError(f"parameter '{name}' is fixed: it cannot change after "
+                                 f"initialisation")
+        params = self._params()
+        if params != core.params:
+            core.params = params
+        if self.follow_speed:
+            core.Omega = float(self.Omega_in)
+        rep = core.step(step_size, float(self.T_bearing), float(self.T_motor_in),
+                        float(self.Omega_set), hold_speed=bool(self.follow_speed))
+        self._publish(rep)
+
+    def _publish(self, rep: Any) -> None:
+        core = self._core
+        self.psi, self.pi_integral = _wrap(core.psi), core.I
+        self.H_motor, self.H_drag, self.H_bearing = core.H_motor, core.H_drag, core.H_bearing
+        self.T_motor = 0.0 if rep is None else rep.T_motor
+        self.T_drag = 0.0 if rep is None else rep.T_drag
+        self.T_drive = self.T_motor + self.T_drag
+        self.pi_regime = 0 if rep is None else int(rep.regime)
+
+    # ------------------------------------------------------------------ FMU state
+    def _get_fmu_state(self) -> dict[str, Any]:
+        values = {v.name: v.getter() for v in self.vars.values()}
+        core = None if self._core is None else self._core.get_state()
+        return json.loads(json.dumps({"schema": STATE_SCHEMA, "variables": values,
+                                      "core": core, "failure": self._failure,
+                                      "fixed": self._fixed}))
+
+    def _set_fmu_state(self, state: dict[str, Any]) -> None:
+        try:
+            if state.get("schema") != STATE_SCHEMA:
+                raise ValueError("not a drivetrain FMU state")
+            for name, value in state["variables"].items():
+                if name != "Omega":
+                    setattr(self, name, value)
+            self._failure, self._fixed = str(state["failure"]), dict(state["fixed"])
+            if state["core"] is not None:
+                from rotortd_drive import DriveCore
+
+                self._core = DriveCore(self._params(), 0.0)
+                self._core.set_state(state["core"])
+        except Exception as exc:
+            self._fail(f"setFMUstate failed: {exc}")

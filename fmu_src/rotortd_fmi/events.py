@@ -1,0 +1,104 @@
+"""PythonFMU adapter of the source FMU TouchdownEvents: a scene's event schedule.
+
+The FMU's script ``fmu_src/TouchdownEvents.py`` only subclasses ``TouchdownEventsAdapter``.
+
+FMPy's SSP master sets only inputs, never parameters mid-run, and every engine must run the
+same SSP; a tiny source FMU is the portable way to step ``amb_on`` at the failure time and
+to switch an external force on and off. Outputs are piecewise constant in time:
+
+    amb_on = amb_before for t < t_fail, amb_after from t_fail on        [1]
+    F_x, F_y = F_x_step, F_y_step for t_force_on <= t < t_force_off, else 0   [N]
+
+The output published after ``doStep(t, h)`` is the schedule's value at ``t + h``, so the
+component it feeds holds, over the step starting at T, the value at T (a Jacobi master then
+applies the switch exactly at the communication point at or after the event time).
+Standard library only; no state beyond the parameters.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pythonfmu import DefaultExperiment, Fmi2Slave, Real
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+
+VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
+    "t_fail": ("s", None, None),
+    "amb_before": ("1", 0.0, 1.0),
+    "amb_after": ("1", 0.0, 1.0),
+    "t_force_on": ("s", None, None),
+    "t_force_off": ("s", None, None),
+    "F_x_step": ("N", None, None),
+    "F_y_step": ("N", None, None),
+    "amb_on": ("1", 0.0, 1.0),
+    "F_x": ("N", None, None),
+    "F_y": ("N", None, None),
+}
+
+TIME_EPS = 1e-9  # s: host clocks that add h repeatedly may land just before an event time
+
+PARAMETERS: tuple[tuple[str, float, str], ...] = (
+    ("t_fail", 1e30, "Time of the bearing failure [s]"),
+    ("amb_before", 1.0, "amb_on before t_fail [1], in [0, 1]"),
+    ("amb_after", 0.0, "amb_on from t_fail on [1], in [0, 1]"),
+    ("t_force_on", 1e30, "Start of the external force step [s]"),
+    ("t_force_off", 1e30, "End of the external force step [s]"),
+    ("F_x_step", 0.0, "External force x during the step [N]"),
+    ("F_y_step", 0.0, "External force y during the step [N]"),
+)
+OUTPUTS: tuple[tuple[str, str], ...] = (
+    ("amb_on", "Magnetic bearing state for the step that starts now [1]"),
+    ("F_x", "External force x for the step that starts now [N]"),
+    ("F_y", "External force y for the step that starts now [N]"),
+)
+
+
+class TouchdownEventsAdapter(Fmi2Slave):
+    """Schedule of amb_on (bearing failure) and of an external force step."""
+
+    author = "rotor-touchdown project"
+    description = "Event schedule of a touchdown scene: amb_on step and external force step."
+    version = "0.1.0"
+    license = "MIT"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-4)
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        for name, start, desc in PARAMETERS:
+            setattr(self, name, start)
+            self.register_variable(Real(name, causality=Fmi2Causality.parameter,
+                                        variability=Fmi2Variability.tunable,
+                                        description=desc))
+        self._t_now = 0.0   # the outputs are the schedule at this time [s]
+        for name, desc in OUTPUTS:
+            self.register_variable(Real(name, causality=Fmi2Causality.output,
+                                        initial=Fmi2Initial.exact, description=desc,
+                                        getter=self._getter(name)))
+        self._t0 = 0.0
+
+    def _getter(self, name: str) -> Any:
+        return lambda: self.schedule(self._t_now)[name]
+
+    def setup_experiment(self, start_time: float = 0.0, stop_time: float | None = None,
+                         tolerance: float | None = None) -> None:
+        self._t0 = float(start_time)
+
+    def exit_initialization_mode(self) -> bool:
+        self._t_now = self._t0
+        return True
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        try:
+            self._t_now = current_time + step_size
+            return True
+        except Exception as exc:
+            self.log(f"do_step failed: {exc}", Fmi2Status.error)
+            return False
+
+    def schedule(self, t: float) -> dict[str, float]:
+        """The outputs at time t [s]: amb_on [1], F_x, F_y [N]."""
+        te = t + TIME_EPS
+        force_on = self.t_force_on <= te < self.t_force_off
+        return {"amb_on": float(self.amb_before if te < self.t_fail else self.amb_after),
+                "F_x": float(self.F_x_step) if force_on else 0.0,
+                "F_y": float(self.F_y_step) if force_on else 0.0}
