@@ -116,6 +116,37 @@ def _unit_scale(g0: float, g1: float, g2: float, g3: float) -> tuple[float, ...]
     return math.ldexp(g0, e), math.ldexp(g1, e), math.ldexp(g2, e), math.ldexp(g3, e)
 
 
+def _negative_throughout(g0: float, g1: float, g2: float, g3: float, tau: float) -> bool:
+    """Quick sufficient test that p < 0 on [0, tau] (g3 >= 0): p(u) <= g0 + its positive
+    terms at tau."""
+    return g0 + tau * (max(g1, 0.0) + tau * (0.5 * max(g2, 0.0) + tau * g3 / 6.0)) < 0.0
+
+
+def g3_bound(fm: FlightModel, v: complex, tau: float) -> float:
+    """Bound G3 (m^2/s^3) of |g'''| on a free flight of length tau (s) that starts with
+    velocity v (m/s, inertial) and stays inside the clearance (module docstring)."""
+    V = abs(v) + fm.K * tau
+    A = fm.beta * V + fm.K
+    Jm = fm.beta * A + fm.kappa * V + fm.J
+    return 6.0 * V * A + 2.0 * fm.c_r * Jm + TINY  # rounded up, never 0 by underflow
+
+
+def flight_is_clear(fm: FlightModel, z: complex, v: complex, E: complex, tau: float) -> bool:
+    """True if the cubic bound proves that the free flight from (z, v) (m, m/s, inertial;
+    phasor E = e^{i psi}) stays off the wall for tau seconds: the first test of
+    ``ContactLocator.find``, for callers that only need a yes. False means 'not proved'.
+    The start is at least TOL_G inside, so |g| is far from underflow and the coefficients
+    need no rescaling."""
+    c2 = fm.c_r * fm.c_r
+    g = (z * z.conjugate()).real - c2
+    if g >= -TOL_G_ULPS * EPS * c2:
+        return False
+    acc = fm.accel(z, v, E)
+    g1 = 2.0 * (z.conjugate() * v).real
+    g2 = 2.0 * (v * v.conjugate()).real + 2.0 * (z.conjugate() * acc).real
+    return _negative_throughout(g, g1, g2, g3_bound(fm, v, tau), tau)
+
+
 def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work) -> float | None:
     """Lower bound of the first root in (0, tau] of p(u) = g0 + g1 u + g2 u^2/2 + g3 u^3/6.
 
@@ -123,8 +154,8 @@ def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
     None when p < 0 on all of (0, tau]; otherwise a u > 0 with p < 0 on (0, u].
     """
     g0, g1, g2, g3 = _unit_scale(g0, g1, g2, g3)
-    if g0 < 0.0 and g0 + tau * (max(g1, 0.0) + tau * (0.5 * max(g2, 0.0) + tau * g3 / 6.0)) < 0:
-        return None  # p <= g0 + (its positive terms at tau) < 0: the common case, quickly
+    if g0 < 0.0 and _negative_throughout(g0, g1, g2, g3, tau):
+        return None  # the common case, quickly
     if g0 == 0.0:
         return _safe_step_on_wall(g1, g2, g3, tau, work)
     knots = [0.0, *_critical_points(g1, g2, g3, tau), tau]
@@ -223,7 +254,7 @@ class ContactLocator:
         contact can be resolved whatever g3 is (g3 = 0: a rotor at rest on the wall)."""
         g3 = self.g3(z, v, E)
         fm = self.fm
-        G3 = self.g3_bound(v, 0.0)
+        G3 = g3_bound(self.fm, v, 0.0)
         w = max(fm.rate, abs(v) / fm.c_r)
         cubic = (48.0 * self.tol_g / max(-g3, 1e-300)) ** (1.0 / 3.0)
         if G3 * w > 0.0:
@@ -239,14 +270,6 @@ class ContactLocator:
         tol_g1 = 16.0 * EPS * fm.c_r * abs(v) + G2_FLOOR
         tol_g2 = 256.0 * EPS * (abs(v) ** 2 + fm.c_r * force) + G2_FLOOR
         return tol_g1, tol_g2
-
-    def g3_bound(self, v: complex, tau: float) -> float:
-        """Bound G3 (m^2/s^3) of |g'''| on an interval of length tau starting at velocity v."""
-        fm = self.fm
-        V = abs(v) + fm.K * tau
-        A = fm.beta * V + fm.K
-        Jm = fm.beta * A + fm.kappa * V + fm.J
-        return 6.0 * V * A + 2.0 * fm.c_r * Jm + TINY  # rounded up, never 0 by underflow
 
     def find(self, h: float, on_wall: bool, work: Work) -> Contact | None:
         """First contact in (0, h], or None. ``on_wall``: the start lies on the circle."""
@@ -287,14 +310,14 @@ class ContactLocator:
     ) -> float | None:
         """A safe step (s) from the current point, or None if no contact in `remaining`."""
         tau = min(remaining, self.horizon)
-        u = safe_step(g, g1, g2, self.g3_bound(v, tau), tau, work)
+        u = safe_step(g, g1, g2, g3_bound(self.fm, v, tau), tau, work)
         if u is None:
             return tau if tau < remaining else None
         for _ in range(2):  # tighten the bound on a shorter interval
             if u <= 0.0 or u >= 0.25 * tau:
                 break
             tau = min(remaining, 4.0 * u)
-            u2 = safe_step(g, g1, g2, self.g3_bound(v, tau), tau, work)
+            u2 = safe_step(g, g1, g2, g3_bound(self.fm, v, tau), tau, work)
             if u2 is None:
                 return tau if tau < remaining else None
             u = max(u, u2)

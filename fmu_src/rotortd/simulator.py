@@ -44,7 +44,7 @@ from .contact import (
     phase_integral,
     wrap_angle,
 )
-from .events import ContactLocator, Work
+from .events import ContactLocator, Work, flight_is_clear
 from .flight import FlightModel
 from .impact import Impact, reset
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
@@ -384,8 +384,10 @@ class TouchdownCore:
         W, a = float(Omega), float(amb_on)
         self._set_inputs(W, F, a)
         cap = _cap(h, self._w_inputs, abs(self._v) / self._p.c_r)
-        if self._clear and self._mode == MODE_FREE:
-            return self._clear_flight(h, cap)
+        if self._mode == MODE_FREE:
+            quick = self._proved_free_step(h, cap)
+            if quick is not None:
+                return quick
         tally = _Tally()
         work = Work()
         self._roll_lenient = False
@@ -409,16 +411,31 @@ class TouchdownCore:
         self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
         return rep
 
-    def _clear_flight(self, h: float, cap: int) -> StepReport:
-        """A step of a flight that the envelope proved never reaches the wall under the
-        held inputs (``_clear``): one closed-form propagation, nothing to search or tally."""
+    def _proved_free_step(self, h: float, cap: int) -> StepReport | None:
+        """A free step proved contact-free without a search: by the envelope for all time
+        under the held inputs (``_clear``), or by the cubic bound of ``flight_is_clear`` over
+        the whole step. Then one closed-form propagation, nothing to tally; else None (the
+        caller searches). Either way the step ends in the same state as a search that finds
+        nothing, which also propagates once from the start."""
         fm = self._fm
         assert fm is not None
-        self._z, self._v = fm.propagate(self._z, self._v, self._phasor(), h, cache=True)
+        E = self._phasor()
+        work = 1
+        if not self._clear:
+            if self._on_wall:
+                return None
+            if self._t >= self._envelope_at:
+                work += 1
+                self._check_envelope(fm, self._t, E)
+            if not self._clear:
+                work += 1
+                if not flight_is_clear(fm, self._z, self._v, E, h):
+                    return None
+        self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
         self._advance_psi(h)
         self._on_wall = False
         self._tick(h)
-        return StepReport(work=1, work_cap=cap)
+        return StepReport(work=work, work_cap=cap)
 
     @staticmethod
     def _reject_inputs(h: float, Omega: float, F: complex, amb_on: float) -> None:
