@@ -280,14 +280,15 @@ def run_direct(sc: Scene, method: str, rtol: float) -> RunResult:
     atol = [rtol * c_r] * 2 + [rtol * c_r * W] * 2
     signal.signal(signal.SIGPROF, _on_cpu_limit)
     signal.setitimer(signal.ITIMER_PROF, CPU_LIMIT)
-    try:
-        r = direct_simulate(asdict(sc.params), sc.z0, sc.v0, sc.psi0, 0.0, sc.segments(),
-                            method=method, rtol=rtol, atol=atol,
-                            max_impacts=MAX_DIRECT_IMPACTS)
+    try:  # the one-shot timer may also fire inside the inner finally: catch it there too
+        try:
+            r = direct_simulate(asdict(sc.params), sc.z0, sc.v0, sc.psi0, 0.0,
+                                sc.segments(), method=method, rtol=rtol, atol=atol,
+                                max_impacts=MAX_DIRECT_IMPACTS)
+        finally:
+            signal.setitimer(signal.ITIMER_PROF, 0.0)
     except CpuLimit:
         return RunResult(0j, 0j, 0.0, 0, {}, ok=False)
-    finally:
-        signal.setitimer(signal.ITIMER_PROF, 0.0)
     imps = {i + 1: (d["t"], d["rdot"]) for i, d in enumerate(r.impacts)}
     return RunResult(r.z, r.v, r.psi, len(r.impacts), imps,
                      r.status == "ok" and abs(r.t - T_END) < 1e-9)

@@ -106,11 +106,15 @@ def _critical_points(g1: float, g2: float, g3: float, tau: float) -> list[float]
     return sorted(u for u in pts if 0.0 < u < tau)
 
 
+_NO_RESCALE = 2.0**-600
+"""Cubics with a coefficient at least this large need no rescaling (_unit_scale)."""
+
+
 def _unit_scale(g0: float, g1: float, g2: float, g3: float) -> tuple[float, ...]:
     """The coefficients times a power of two (exact) that brings the largest near 1, when
     all are below 2^-600: else p(u) of subnormal forces underflows to -0.0, a false root."""
     big = max(abs(g0), abs(g1), abs(g2), abs(g3))
-    if big == 0.0 or big >= 2.0**-600:
+    if big == 0.0 or big >= _NO_RESCALE:
         return g0, g1, g2, g3
     e = -math.frexp(big)[1]
     return math.ldexp(g0, e), math.ldexp(g1, e), math.ldexp(g2, e), math.ldexp(g3, e)
@@ -135,11 +139,11 @@ def flight_is_clear(fm: FlightModel, z: complex, v: complex, E: complex, tau: fl
     """True if the cubic bound proves that the free flight from (z, v) (m, m/s, inertial;
     phasor E = e^{i psi}) stays off the wall for tau seconds: the first test of
     ``ContactLocator.find``, for callers that only need a yes. False means 'not proved'.
-    The start is at least TOL_G inside, so |g| is far from underflow and the coefficients
-    need no rescaling."""
+    Cubics that would need rescaling (|g| < 2^-600, a sub-atomic clearance) are left to
+    the search."""
     c2 = fm.c_r * fm.c_r
     g = (z * z.conjugate()).real - c2
-    if g >= -TOL_G_ULPS * EPS * c2:
+    if g >= -TOL_G_ULPS * EPS * c2 or g > -_NO_RESCALE:  # at the wall, or tiny: search
         return False
     acc = fm.accel(z, v, E)
     g1 = 2.0 * (z.conjugate() * v).real
@@ -153,7 +157,8 @@ def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
     Requires g0 <= 0 (g0 == 0 means 'on the wall'; then p(u)/u is examined). Returns
     None when p < 0 on all of (0, tau]; otherwise a u > 0 with p < 0 on (0, u].
     """
-    g0, g1, g2, g3 = _unit_scale(g0, g1, g2, g3)
+    if g0 > -_NO_RESCALE:  # else the coefficients are not all tiny: nothing to rescale
+        g0, g1, g2, g3 = _unit_scale(g0, g1, g2, g3)
     if g0 < 0.0 and _negative_throughout(g0, g1, g2, g3, tau):
         return None  # the common case, quickly
     if g0 == 0.0:
