@@ -167,7 +167,7 @@ def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
     lo = 0.0
     for hi in knots[1:]:
         if _cubic(g0, g1, g2, g3, hi) >= 0.0:
-            return _bracket_left(lambda u: _cubic(g0, g1, g2, g3, u), lo, hi, work)
+            return _bracket_left((g0, g1, g2, g3), lo, hi, work)
         lo = hi
     return None
 
@@ -176,25 +176,31 @@ def _safe_step_on_wall(g1: float, g2: float, g3: float, tau: float, work: Work) 
     """First root of q(u) = g1 + g2 u/2 + g3 u^2/6 in (0, tau] (p = u q), q(0) = g1 <= 0."""
     if g1 > 0.0 or (g1 == 0.0 and g2 >= 0.0):
         return 0.0
-
-    def q(u: float) -> float:
-        return g1 + u * (0.5 * g2 + u * g3 / 6.0)
-
     knots = [0.0]
     if g3 != 0.0 and 0.0 < -1.5 * g2 / g3 < tau:
         knots.append(-1.5 * g2 / g3)
     knots.append(tau)
     lo = 0.0
     for hi in knots[1:]:
-        if q(hi) >= 0.0:
-            return _bracket_left(q, lo, hi, work)
+        if g1 + hi * (0.5 * g2 + hi * g3 / 6.0) >= 0.0:
+            return _bracket_left((None, g1, g2, g3), lo, hi, work)
         lo = hi
     return None
 
 
-def _bracket_left(f, lo: float, hi: float, work: Work) -> float:
-    """Shrink [lo, hi] (f(lo) < 0 <= f(hi), f monotone) by Illinois; return the left end."""
-    flo, fhi = f(lo), f(hi)
+def _bracket_left(
+    coeffs: tuple[float | None, float, float, float], lo: float, hi: float, work: Work
+) -> float:
+    """Shrink [lo, hi] by Illinois; return the left end. ``coeffs`` = (g0, g1, g2, g3): the
+    function is p(u) = g0 + u q(u), q(u) = g1 + u (g2/2 + u g3/6), or q itself when g0 is
+    None (on the wall); it is increasing on [lo, hi] with f(lo) < 0 <= f(hi). Evaluated
+    inline (the same expressions as _cubic): this loop is the search's innermost one."""
+    g0, g1, g2, g3 = coeffs
+    c2 = 0.5 * g2
+    flo = g1 + lo * (c2 + lo * g3 / 6.0)
+    fhi = g1 + hi * (c2 + hi * g3 / 6.0)
+    if g0 is not None:
+        flo, fhi = g0 + lo * flo, g0 + hi * fhi
     side = 0
     for _ in range(100):
         work.iters += 1
@@ -203,7 +209,9 @@ def _bracket_left(f, lo: float, hi: float, work: Work) -> float:
         x = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
         if not lo < x < hi:
             x = 0.5 * (lo + hi)
-        fx = f(x)
+        fx = g1 + x * (c2 + x * g3 / 6.0)
+        if g0 is not None:
+            fx = g0 + x * fx
         if fx < 0.0:
             lo, flo = x, fx
             if side == -1:
