@@ -74,7 +74,7 @@ class WorkCapExceeded(RuntimeError):
     """A step exceeded its work cap."""
 
 
-@dataclass
+@dataclass(slots=True)
 class StepReport:
     """What happened in one step (SI, inertial). Forces are step averages (impulse/h)."""
 
