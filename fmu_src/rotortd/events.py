@@ -267,7 +267,7 @@ class ContactLocator:
         contact can be resolved whatever g3 is (g3 = 0: a rotor at rest on the wall)."""
         g3 = self.g3(z, v, E)
         fm = self.fm
-        G3 = g3_bound(self.fm, v, 0.0)
+        G3 = g3_bound(fm, v, 0.0)
         w = max(fm.rate, abs(v) / fm.c_r)
         cubic = (48.0 * self.tol_g / max(-g3, 1e-300)) ** (1.0 / 3.0)
         if G3 * w > 0.0:
