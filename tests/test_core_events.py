@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import cmath
 import math
+import random
 
 import pytest
 from rotortd import RotorParams, TouchdownCore, work_cap
-from rotortd.events import EPS, ContactLocator, Work
+from rotortd.events import EPS, ContactLocator, Work, flight_is_clear
 from rotortd.flight import FlightModel
 
 from tests.reference.mp_reference import mp_first_impact
@@ -112,3 +113,46 @@ def test_free_whirl_skips_the_search() -> None:
     core = TouchdownCore.on_steady_whirl(p, W0)
     works = [core.step(1e-3, W0).work for _ in range(100)]
     assert works[0] <= 2 and max(works[1:]) == 1
+
+
+def _random_flight(rng: random.Random) -> tuple[FlightModel, complex, complex, complex, float]:
+    """A random free flight inside the clearance: damping, imbalance, gravity, a constant
+    force, spin speed and direction, position, velocity and step length (log-uniform)."""
+    p = BASE.replace(c=rng.uniform(0.0, 1.0) * 2.0 * math.sqrt(BASE.m * BASE.k),
+                     e_c=BASE.e_c * 10 ** rng.uniform(-3.0, 0.5), g=rng.choice([0.0, 9.81]))
+    W = rng.choice([-1.0, 1.0]) * 10 ** rng.uniform(1.0, 3.3)
+    F = cmath.rect(p.m * 9.81 * rng.uniform(0.0, 3.0), rng.uniform(-math.pi, math.pi))
+    fm = FlightModel(p, W, F, rng.choice([1.0, 1.0, 0.3]))
+    z0 = cmath.rect(p.c_r * rng.uniform(0.0, 0.999999), rng.uniform(-math.pi, math.pi))
+    v0 = cmath.rect(p.c_r * abs(W) * rng.uniform(0.0, 2.0), rng.uniform(-math.pi, math.pi))
+    E0 = cmath.exp(1j * rng.uniform(-math.pi, math.pi))
+    return fm, z0, v0, E0, 10 ** rng.uniform(-6.0, -1.0)
+
+
+def test_flight_proved_clear_never_reaches_the_wall() -> None:
+    """flight_is_clear (a step with no search) proves only what is true: on 3000 random
+    flights, every step it proves free is free in the search too, and at 400 points of the
+    exact flight map (independent of the cubic bound). Both verdicts must occur."""
+    rng = random.Random(20261121)
+    proved = refused = 0
+    for _ in range(3000):
+        fm, z0, v0, E0, h = _random_flight(rng)
+        if not flight_is_clear(fm, z0, v0, E0, h):
+            refused += 1
+            continue
+        proved += 1
+        assert ContactLocator(fm, z0, v0, E0).find(h, False, Work()) is None
+        r_max = max(abs(fm.propagate(z0, v0, E0, h * k / 400)[0]) for k in range(1, 401))
+        assert r_max < fm.c_r, f"proved free, yet |z| reaches {r_max / fm.c_r!r} c_r"
+    assert proved > 300 and refused > 300, (proved, refused)
+
+
+@pytest.mark.parametrize("excess", [1e-10, 1e-14])
+def test_flight_reaching_the_wall_is_never_proved_clear(excess: float) -> None:
+    """The orbit of test_grazing_within_one_long_step, reaching c_r (1 + excess) half a
+    period in: a step over it is never proved free, however slight the excursion."""
+    p, F, z0, v0 = _offset_whirl(excess)
+    fm = FlightModel(p, W0, F, 1.0)
+    period = 2 * math.pi / W0
+    for h in (0.5 * period, period, 3 * period):
+        assert not flight_is_clear(fm, z0, v0, cmath.exp(1j * math.pi), h)
