@@ -382,7 +382,8 @@ class TouchdownCore:
                 and math.isfinite(F.real) and math.isfinite(F.imag)):
             self._reject_inputs(h, Omega, F, amb_on)
         W, a = float(Omega), float(amb_on)
-        self._set_inputs(W, F, a)
+        if (W, F, a) != self._inputs or self._fm is None:
+            self._set_inputs(W, F, a)
         cap = _cap(h, self._w_inputs, abs(self._v) / self._p.c_r)
         if self._mode == MODE_FREE:
             quick = self._proved_free_step(h, cap)
@@ -454,13 +455,13 @@ class TouchdownCore:
         self._t = t
 
     def _set_inputs(self, W: float, F: complex, a: float) -> None:
-        if (W, F, a) != self._inputs or self._fm is None:
-            self._inputs = (W, F, a)
-            self._w_inputs = _input_rate(self._p, W, F, a)
-            self._fm = FlightModel(self._p, W, F, a)
-            self._wf = WallForces.build(self._p, W, F, a)
-            self._unclear()
-            self._locked = False
+        """New held inputs (or parameters): rebuild the flight and wall models."""
+        self._inputs = (W, F, a)
+        self._w_inputs = _input_rate(self._p, W, F, a)
+        self._fm = FlightModel(self._p, W, F, a)
+        self._wf = WallForces.build(self._p, W, F, a)
+        self._unclear()
+        self._locked = False
 
     def _fill_report(self, rep: StepReport, tal: _Tally, work: Work, h: float) -> None:
         inv = 1.0 / h if h > 0.0 else 0.0
