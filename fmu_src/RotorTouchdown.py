@@ -14,6 +14,7 @@ class RotorTouchdown(_adapter.RotorTouchdownAdapter):
     """The FMU's slave class; see ``rotortd_fmi.touchdown.RotorTouchdownAdapter``."""
 
     def __init__(self, **kwargs: object) -> None:
-        # Needed: PythonFMU 0.7 execs this script in a fresh namespace that only the
-        # script's own functions keep alive. Without one, fmi2Instantiate segfaults.
+        # Needed: without a function of its own in this script, fmi2Instantiate
+        # segfaults (PythonFMU 0.7.0 execs the script in a fresh namespace, which seems
+        # to be kept alive only by the script's own functions).
         super().__init__(**kwargs)
