@@ -157,17 +157,25 @@ class FlightModel:
     def radius_bound_parts(self, z0: complex, v0: complex, E0: complex) -> tuple[float, float]:
         """(|Z0| + |Z1|, bound of the transient) (m), the two terms of sup_radius_bound;
         (inf, inf) where no finite bound exists."""
-        kap, beta, W = self.kappa, self.beta, self.Omega
-        if kap <= 0.0:
+        split = self._steady_split(z0, v0, E0)
+        if split is None:
             return math.inf, math.inf
-        den = complex(kap - W * W, beta * W)
-        if den == 0:
-            return math.inf, math.inf
+        Z0, Z1, zeta, eta = split
+        return abs(Z0) + abs(Z1), _transient_bound(self.beta, self.kappa, zeta, eta)
+
+    def _steady_split(
+        self, z0: complex, v0: complex, E0: complex
+    ) -> tuple[complex, complex, complex, complex] | None:
+        """(Z0, Z1 E0, zeta, eta): the steady whirl z = Z0 + Z1 E0 e^{i Omega s} (m) and the
+        transient's start zeta = z0 - Z0 - Z1 E0 (m), eta = v0 - i Omega Z1 E0 (m/s); None
+        without stiffness or at undamped resonance (no steady whirl)."""
+        kap, W = self.kappa, self.Omega
+        den = complex(kap - W * W, self.beta * W)
+        if kap <= 0.0 or den == 0:
+            return None
         Z0 = self.f0 / kap
         Z1 = self.F1 * E0 / den
-        zeta = z0 - Z0 - Z1
-        eta = v0 - 1j * W * Z1
-        return abs(Z0) + abs(Z1), _transient_bound(beta, kap, zeta, eta)
+        return Z0, Z1, z0 - Z0 - Z1, v0 - 1j * W * Z1
 
     # -- modal evaluation (search) --------------------------------------------------------
 
@@ -180,14 +188,11 @@ class FlightModel:
         the modal amplitudes exceed MODAL_GAIN times the state's own scale, i.e. whenever
         cancellation between modes could cost more than a few ulp of c_r.
         """
-        kap, la, lb, W = self.kappa, self.l1, self.l2, self.Omega
-        den = complex(kap - W * W, self.beta * W)
-        if kap <= 0.0 or den == 0 or la == lb:
+        la, lb, W = self.l1, self.l2, self.Omega
+        split = self._steady_split(z0, v0, E0) if la != lb else None
+        if split is None:
             return None
-        Z0 = self.f0 / kap
-        Z1 = self.F1 * E0 / den
-        zeta = z0 - Z0 - Z1
-        eta = v0 - 1j * W * Z1
+        Z0, Z1, zeta, eta = split
         a1 = (eta - lb * zeta) / (la - lb)
         a2 = (la * zeta - eta) / (la - lb)
         z_scale = max(abs(z0), self.c_r)
