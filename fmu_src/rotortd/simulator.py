@@ -792,6 +792,8 @@ class TouchdownCore:
         self._psi, self._turns = float(st["psi"]), int(st["turns"])
         self._mode = int(st["mode"])
         self._theta, self._dtheta = float(st["theta"]), float(st["dtheta"])
+        W, fx, fy, a = st["inputs"]
+        self._set_inputs(float(W), complex(fx, fy), float(a))  # clears _locked: restored next
         self._slip, self._locked = float(st["slip"]), bool(st["locked"])
         self._on_wall = bool(st["on_wall"])
         self._n_impacts = int(st["n_impacts"])
@@ -799,9 +801,3 @@ class TouchdownCore:
         self._E_diss = float(st["E_diss"])
         self._t_contact = math.nan if st["t_contact"] is None else float(st["t_contact"])
         self._H = math.inf if st["H"] is None else float(st["H"])
-        W, fx, fy, a = st["inputs"]
-        self._inputs = (float(W), complex(fx, fy), float(a))
-        self._fm = FlightModel(self._p, *self._inputs)
-        self._wf = WallForces.build(self._p, *self._inputs)
-        self._w_inputs = _input_rate(self._p, *self._inputs)
-        self._unclear()
