@@ -325,13 +325,12 @@ class RotorTouchdownAdapter(Fmi2Slave):
         import rotortd  # resources/rotortd inside the FMU
 
         self._failure = ""
-        self._seen_fixed = self._seen_tunables = self._seen_inputs = None
-        self._changed = True
+        self._forget_checks()
         for name, _start, _desc in REAL_PARAMETERS:
             _check_finite(name, float(getattr(self, name)))
         self._check_inputs()
         params = self._make_params(rotortd)
-        omega, f_ext, amb = self._input_values()
+        omega, f_ext, amb, _t_drive = self._input_values()
         if self.start_steady:
             core = rotortd.TouchdownCore.on_steady_whirl(
                 params, omega, F_ext=f_ext, amb_on=amb, psi0=float(self.psi0), t0=self._t0)
@@ -370,9 +369,15 @@ class RotorTouchdownAdapter(Fmi2Slave):
         return dict(zip(FIXED, _get_fixed(self)))
 
     # ------------------------------------------------------------------ stepping
-    def _input_values(self) -> tuple[float, complex, float]:
+    def _input_values(self) -> tuple[float, complex, float, float]:
+        """(Omega, F_ext, amb_on, T_drive) as the core takes them."""
         return (float(self.Omega), complex(float(self.F_x), float(self.F_y)),
-                float(self.amb_on))
+                float(self.amb_on), float(self.T_drive))
+
+    def _forget_checks(self) -> None:
+        """Make the next step validate every group (after initialisation or a restore)."""
+        self._seen_fixed = self._seen_tunables = self._seen_inputs = None
+        self._changed = True
 
     def _check_inputs(self) -> None:
         for name, _start, _desc in INPUTS:
@@ -405,9 +410,7 @@ class RotorTouchdownAdapter(Fmi2Slave):
         if inputs != self._seen_inputs:
             self._check_inputs()
             self._seen_inputs = inputs
-            omega, f_x, f_y, amb, t_drive = inputs
-            self._step_inputs = (float(omega), complex(float(f_x), float(f_y)), float(amb),
-                                 float(t_drive))
+            self._step_inputs = self._input_values()
         if tunables != self._seen_tunables:
             self._apply_tunables()
             self._seen_tunables = tunables
@@ -541,8 +544,7 @@ class RotorTouchdownAdapter(Fmi2Slave):
         self._t0 = float(adapter["t0"])
         self._failure = str(adapter["failure"])
         self._fixed_snapshot = dict(adapter["fixed_snapshot"])
-        self._seen_fixed = self._seen_tunables = self._seen_inputs = None
-        self._changed = True
+        self._forget_checks()
         spin = adapter.get("spin")
         self._spin = None if spin is None else self._make_spin(float(spin))
 
