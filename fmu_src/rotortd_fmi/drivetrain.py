@@ -24,8 +24,10 @@ import json
 import math
 from typing import Any
 
-from pythonfmu import Boolean, DefaultExperiment, Fmi2Slave, Integer, Real
-from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+from pythonfmu import Boolean, DefaultExperiment, Integer, Real
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
+
+from .guard import GuardedSlave
 
 STATE_SCHEMA = "rotortd-drivetrain-fmu-state"
 
@@ -91,7 +93,7 @@ def _wrap(angle: float) -> float:
     return math.pi if w == -math.pi else w
 
 
-class DrivetrainAdapter(Fmi2Slave):
+class DrivetrainAdapter(GuardedSlave):
     """Drivetrain J Omega' = T_motor - b Omega + T_bearing; torque motor or limited PI."""
 
     author = "rotor-touchdown project"
@@ -149,29 +151,6 @@ class DrivetrainAdapter(Fmi2Slave):
         return float(self.Omega_in if self.follow_speed else self.Omega0)
 
     # ------------------------------------------------------------------ FMI calls
-    def exit_initialization_mode(self) -> bool:
-        try:
-            self._initialise()
-            return True
-        except Exception as exc:
-            self._fail(f"initialisation failed: {exc}")
-            return False
-
-    def do_step(self, current_time: float, step_size: float) -> bool:
-        if self._failure:
-            self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
-            return False
-        try:
-            self._step(current_time, step_size)
-            return True
-        except Exception as exc:
-            self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
-            return False
-
-    def _fail(self, msg: str) -> None:
-        self._failure = msg
-        self.log(msg, Fmi2Status.error)
-
     # ------------------------------------------------------------------ model
     def _params(self) -> Any:
         from rotortd_drive import DriveParams
@@ -190,7 +169,7 @@ class DrivetrainAdapter(Fmi2Slave):
         self._fixed = {n: getattr(self, n) for n in (*FIXED, "motor", "follow_speed")}
         self._publish(None)
 
-    def _step(self, current_time: float, step_size: float) -> None:
+    def _step(self, current_time: float, step_size: float) -> bool:
         core = self._core
         if core is None:
             raise ValueError("do_step before exitInitializationMode")
@@ -206,6 +185,7 @@ class DrivetrainAdapter(Fmi2Slave):
         rep = core.step(step_size, float(self.T_bearing), float(self.T_motor_in),
                         float(self.Omega_set), hold_speed=bool(self.follow_speed))
         self._publish(rep)
+        return True
 
     def _publish(self, rep: Any) -> None:
         core = self._core

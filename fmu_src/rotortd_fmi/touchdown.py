@@ -9,8 +9,8 @@ variables, validates parameters and inputs, hands each communication step to
 Rules this file follows (see the project's FMI notes):
 - ``__init__`` is cheap and free of side effects (the builder instantiates the class).
 - Derived objects (RotorParams, TouchdownCore) are built in ``exit_initialization_mode``.
-- No exception escapes into the PythonFMU C wrapper: errors are logged with
-  ``Fmi2Status.error`` and the next ``do_step`` returns False (fmi2Discard).
+- No exception escapes into the PythonFMU C wrapper (``guard.GuardedSlave``): errors are
+  logged with ``Fmi2Status.error`` and the next ``do_step`` returns False (fmi2Discard).
 - The FMU state (get/set/serialize) holds the core's full state plus this adapter's own
   variables, as JSON with an explicit schema; never pickle.
 - Only the standard library and ``rotortd`` are imported at run time.
@@ -28,8 +28,10 @@ import operator
 import os
 from typing import Any
 
-from pythonfmu import Boolean, DefaultExperiment, Fmi2Slave, Integer, Real, String
+from pythonfmu import Boolean, DefaultExperiment, Integer, Real, String
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+
+from .guard import GuardedSlave
 
 STATE_SCHEMA = "rotortd-fmu-state"
 STATE_VERSION = 1
@@ -186,7 +188,7 @@ def _same(a: Any, b: Any) -> bool:
     return a == b
 
 
-class RotorTouchdownAdapter(Fmi2Slave):
+class RotorTouchdownAdapter(GuardedSlave):
     """Rotor in a touchdown bearing: AMB spring/damper, imbalance, impacts with friction."""
 
     author = "rotor-touchdown project"
@@ -297,28 +299,6 @@ class RotorTouchdownAdapter(Fmi2Slave):
     def setup_experiment(self, start_time: float = 0.0, stop_time: float | None = None,
                          tolerance: float | None = None) -> None:
         self._t0 = float(start_time)
-
-    def exit_initialization_mode(self) -> bool:
-        try:
-            self._initialise()
-            return True
-        except Exception as exc:  # nothing may escape into the C wrapper
-            self._fail(f"initialisation failed: {exc}")
-            return False
-
-    def do_step(self, current_time: float, step_size: float) -> bool:
-        if self._failure:
-            self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
-            return False
-        try:
-            return self._step(current_time, step_size)
-        except Exception as exc:
-            self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
-            return False
-
-    def _fail(self, msg: str) -> None:
-        self._failure = msg
-        self.log(msg, Fmi2Status.error)
 
     # ------------------------------------------------------------------ initialisation
     def _initialise(self) -> None:

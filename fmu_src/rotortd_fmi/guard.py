@@ -1,0 +1,48 @@
+"""The error guard of the project's stateful adapters (RotorTouchdown, Drivetrain).
+
+No exception may escape into PythonFMU's C wrapper (its fatal path). An adapter derives from
+``GuardedSlave`` and implements ``_initialise()`` and ``_step(t, h) -> bool``; a failure is
+logged with ``Fmi2Status.error``, the call returns False (fmi2Discard), and every later
+``do_step`` is refused with the first failure's message. Standard library and pythonfmu only.
+"""
+
+from __future__ import annotations
+
+from pythonfmu import Fmi2Slave
+from pythonfmu.enums import Fmi2Status
+
+
+class GuardedSlave(Fmi2Slave):
+    """Fmi2Slave whose initialisation and steps report errors instead of raising them."""
+
+    _failure = ""  # non-empty: the model is unusable and do_step refuses
+
+    def exit_initialization_mode(self) -> bool:
+        try:
+            self._initialise()
+            return True
+        except Exception as exc:  # nothing may escape into the C wrapper
+            self._fail(f"initialisation failed: {exc}")
+            return False
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._failure:
+            self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
+            return False
+        try:
+            return self._step(current_time, step_size)
+        except Exception as exc:
+            self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
+            return False
+
+    def _fail(self, msg: str) -> None:
+        self._failure = msg
+        self.log(msg, Fmi2Status.error)
+
+    def _initialise(self) -> None:
+        """Build the model from the parameters (exitInitializationMode); raise on error."""
+        raise NotImplementedError
+
+    def _step(self, current_time: float, step_size: float) -> bool:
+        """One communication step; False refuses it (logged by the step itself)."""
+        raise NotImplementedError
