@@ -266,3 +266,38 @@ def test_integrate_spin_momentum_exact(systems: Path) -> None:
     assert t_end == pytest.approx(0.03)
     assert abs(res) < 1e-11
     assert om < 184.2
+
+
+def _drivetrain_slave(**params: float) -> object:
+    from Drivetrain import Drivetrain
+
+    slave = Drivetrain(instance_name="guard")
+    for name, value in params.items():
+        setattr(slave, name, value)
+    slave.setup_experiment(0.0, None, None)
+    slave.enter_initialization_mode()
+    return slave
+
+
+def _error_messages(slave: object) -> list[str]:
+    from pythonfmu.enums import Fmi2Status
+
+    return [m.msg for m in slave.log_queue if m.status == Fmi2Status.error]
+
+
+def test_drivetrain_errors_are_logged_and_refused_not_raised() -> None:
+    """The shared guard (rotortd_fmi.guard): a bad parameter fails initialisation and a bad
+    input fails its step, each with a named message and fmi2Discard, and every later step
+    is refused; a good step returns True."""
+    bad = _drivetrain_slave(J=-1.0)
+    assert bad.exit_initialization_mode() is False
+    assert bad.do_step(0.0, 1e-3) is False
+    assert any("J=-1.0" in m for m in _error_messages(bad))
+    good = _drivetrain_slave()
+    assert good.exit_initialization_mode() is True
+    assert good.do_step(0.0, 1e-3) is True
+    good.T_bearing = math.nan
+    assert good.do_step(1e-3, 1e-3) is False
+    assert good.do_step(2e-3, 1e-3) is False
+    msgs = _error_messages(good)
+    assert "T_bearing=nan" in msgs[-2] and msgs[-1].startswith("do_step refused")
