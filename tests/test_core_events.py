@@ -8,7 +8,15 @@ import random
 
 import pytest
 from rotortd import RotorParams, TouchdownCore, work_cap
-from rotortd.events import EPS, ContactLocator, Work, flight_is_clear
+from rotortd.events import (
+    EPS,
+    HORIZON,
+    ContactLocator,
+    Work,
+    flight_is_clear,
+    g3_exact,
+    g3_slack,
+)
 from rotortd.flight import FlightModel
 
 from tests.reference.mp_reference import mp_first_impact
@@ -147,6 +155,45 @@ def test_flight_proved_clear_never_reaches_the_wall() -> None:
     assert proved > 300 and refused > 300, (proved, refused)
 
 
+def _bound_violation(fm: FlightModel, z0: complex, v0: complex, E0: complex, tau: float,
+                     slack: float) -> float:
+    """Largest g(u) - p(u) (in c_r^2) over 200 points of [0, tau] while the exact flight
+    stays inside, p the search's bound g + g' u + g'' u^2/2 + (g''' + slack) u^3/6."""
+    c2 = fm.c_r * fm.c_r
+    acc = fm.accel(z0, v0, E0)
+    g0 = abs(z0) ** 2 - c2
+    g1 = 2.0 * (z0.conjugate() * v0).real
+    g2 = 2.0 * abs(v0) ** 2 + 2.0 * (z0.conjugate() * acc).real
+    c3 = g3_exact(fm, z0, v0, acc, E0) + slack
+    worst = -math.inf
+    for k in range(1, 201):
+        u = tau * k / 200
+        z = fm.propagate(z0, v0, E0, u)[0]
+        if abs(z) > fm.c_r:
+            break
+        p = g0 + u * (g1 + u * (0.5 * g2 + u * c3 / 6.0))
+        worst = max(worst, (abs(z) ** 2 - c2 - p) / c2)
+    return worst
+
+
+def test_search_bound_lies_above_the_exact_flight() -> None:
+    """The search's bound (exact g''' plus g3_slack: the quartic remainder over tau and the
+    rounding of g''') lies above g = |z|^2 - c_r^2 of the exact flight map on 600 random
+    flights, over the longest interval one bound covers. Without the slack, the bare cubic
+    Taylor polynomial falls below the flight on many of them: the slack is what makes the
+    bound a bound, and this test would notice its loss."""
+    rng = random.Random(20261122)
+    bare_below = 0
+    for _ in range(600):
+        fm, z0, v0, E0, _h = _random_flight(rng)
+        w = max(fm.rate, abs(v0) / fm.c_r)
+        tau = HORIZON / w
+        slack = g3_slack(fm, v0, tau)
+        assert _bound_violation(fm, z0, v0, E0, tau, slack) <= 64 * EPS
+        bare_below += _bound_violation(fm, z0, v0, E0, tau, 0.0) > 64 * EPS
+    assert bare_below > 30, bare_below
+
+
 @pytest.mark.parametrize("excess", [1e-10, 1e-14])
 def test_flight_reaching_the_wall_is_never_proved_clear(excess: float) -> None:
     """The orbit of test_grazing_within_one_long_step, reaching c_r (1 + excess) half a
@@ -156,3 +203,40 @@ def test_flight_reaching_the_wall_is_never_proved_clear(excess: float) -> None:
     period = 2 * math.pi / W0
     for h in (0.5 * period, period, 3 * period):
         assert not flight_is_clear(fm, z0, v0, cmath.exp(1j * math.pi), h)
+
+
+def test_long_step_keeps_impact_times_to_the_clock() -> None:
+    """One 10 s step over 640 impacts reports each impact at the time 100 steps of 0.1 s
+    do, to 4 ulp of 10 s, and ends in the same state to 1e-12 c_r: the step-local time is
+    summed with its rounding kept. (Summed plainly, one rounding per impact drifted by
+    44 ulp, and the end state by 1.1e-11 c_r.)"""
+    from rotortd_tools.cycles import OMEGA, find_period_one_cycle
+
+    cyc = find_period_one_cycle(0.1)
+    z0, v0, W = 0.999 * cyc.z0, cyc.v0, OMEGA
+    one = TouchdownCore(cyc.params, z0, v0)
+    long_times = [imp.t for imp in one.step(10.0, W).impacts]
+    many = TouchdownCore(cyc.params, z0, v0)
+    short_times = [imp.t for _ in range(100) for imp in many.step(0.1, W).impacts]
+    assert len(long_times) == len(short_times) > 600
+    drift = max(abs(a - b) for a, b in zip(long_times, short_times))
+    assert drift <= 4 * math.ulp(10.0), drift
+    assert abs(one.z - many.z) <= 1e-12 * cyc.params.c_r
+
+
+def test_bound_polynomials_match_their_nested_forms() -> None:
+    """FlightModel.g3_poly and g4_poly are G3 = 6 V A + 2 c_r Jm and G4 = 6 A^2 + 8 V Jm +
+    2 c_r L expanded in V, to rounding, on random flights (any damping, spin, forces)."""
+    rng = random.Random(7)
+    for _ in range(300):
+        fm, _z, v, _E, tau = _random_flight(rng)
+        V = abs(v) + fm.K * tau
+        A = fm.beta * V + fm.K
+        Jm = fm.beta * A + fm.kappa * V + fm.J
+        L = fm.beta * Jm + fm.kappa * A + fm.L_rot
+        G3, G4 = 6.0 * V * A + 2.0 * fm.c_r * Jm, 6.0 * A * A + 8.0 * V * Jm + 2.0 * fm.c_r * L
+        s0, s1, s2 = fm.g3_poly
+        q0, q1, q2 = fm.g4_poly
+        assert min(fm.g3_poly + fm.g4_poly) >= 0.0
+        assert abs(s0 + V * (s1 + V * s2) - G3) <= 16 * EPS * G3
+        assert abs(q0 + V * (q1 + V * q2) - G4) <= 16 * EPS * G4

@@ -3,20 +3,26 @@
 Frame and units: inertial, SI. The gap function is g(s) = |z(s)|^2 - c_r^2 (m^2); a
 contact is its first zero in (0, h].
 
-Method (conservative advancement with a cubic Taylor bound). At a point s with exact
-state (z, v) from the closed form, g, g' = 2 Re(conj(z) v) and g'' = 2|v|^2 + 2 Re(conj(z) z'')
-are exact, and on [s, s + tau], as long as |z| <= c_r,
+Method (conservative advancement with a Taylor bound). At a point s with exact state
+(z, v) from the closed form, g, g' = 2 Re(conj(z) v), g'' = 2|v|^2 + 2 Re(conj(z) z'') and
+g''' = 6 Re(conj(v) z'') + 2 Re(conj(z) z''') are exact to rounding, and on [s, s + tau],
+as long as |z| <= c_r,
 
-    |v| <= V = |v(s)| + K tau,   |z''| <= A = beta V + K,   |z'''| <= beta A + kappa V + J,
-    |g'''| <= G3 = 6 V A + 2 c_r (beta A + kappa V + J)
+    |v| <= V = |v(s)| + K tau,   |z''| <= A = beta V + K,   |z'''| <= Jm = beta A + kappa V + J,
+    |z''''| <= L = beta Jm + kappa A + |Omega| J,
+    |g'''| <= G3 = 6 V A + 2 c_r Jm,   |g''''| <= G4 = 6 A^2 + 8 V Jm + 2 c_r L
 
-(flight.py defines K and J). Hence g(s + u) <= p(u) = g + g' u + g'' u^2/2 + G3 u^3/6.
-If p < 0 on (0, tau] there is no contact there; otherwise the first root u* of p is a
-safe step: a contact before s + u* would be a first exit at which the bound (valid up
-to it) is negative, a contradiction. Advancing by u* converges to a transversal root
-from below with third-order convergence (p and g differ by O(u^3)), and passes a
-near-miss in O(log(1/miss)) steps; a crossing can never be stepped over, whatever its
-depth, which is what makes grazing contacts impossible to miss.
+(flight.py defines K and J). As u^4/24 <= (tau/4) u^3/6 on [0, tau], the quartic
+remainder folds into the cubic term: g(s + u) <= p(u) = g + g' u + g'' u^2/2 + c3 u^3/6,
+c3 = g''' + G4 tau/4 + the rounding band of g''' (``g3_slack``). If p < 0 on (0, tau]
+there is no contact there; otherwise the first root u* of p is a safe step: a contact
+before s + u* would be a first exit at which the bound (valid up to it) is negative, a
+contradiction. Advancing by u* converges to a transversal root from below with
+fourth-order convergence (p and g differ by O(u^4)), and passes a near-miss in
+O(log(1/miss)) steps; a crossing can never be stepped over, whatever its depth, which
+is what makes grazing contacts impossible to miss. ``flight_is_clear``, which only needs
+a yes over one short step, uses the plain cubic bound G3 u^3/6 instead: there the exact
+g''' costs more than it gains (measured).
 
 Resolution: contact is declared when g >= -TOL_G (|z| within 32 ulp of c_r). If the
 trajectory is moving outward there and its predicted excursion beyond the wall exceeds
@@ -46,9 +52,9 @@ BRACKET_RTOL = 1e-6
 """Relative width at which the bracket of the cubic's first root stops (its left end is
 returned). Any point left of the root is a safe step; near a contact the next advance
 starts 1e-6 of a step short of the root and closes the rest with the cubic's own accuracy."""
-HORIZON = 0.25
-"""Longest interval (in units of 1/w, w the flight's fastest rate) one cubic bound covers:
-the bound of g''' grows with the interval, so a longer one only shortens the safe step."""
+HORIZON = 0.5
+"""Longest interval (in units of 1/w, w the flight's fastest rate) one bound covers: the
+slack G4 tau/4 grows with the interval, so a longer one only shortens the safe step."""
 MAX_ADVANCES = 400
 """Advances in one search call (a grazing pass needs ~40); a flight creeping along the
 wall for long may need more, and the caller then resumes from where the search stopped."""
@@ -121,18 +127,38 @@ def _unit_scale(g0: float, g1: float, g2: float, g3: float) -> tuple[float, ...]
 
 
 def _negative_throughout(g0: float, g1: float, g2: float, g3: float, tau: float) -> bool:
-    """Quick sufficient test that p < 0 on [0, tau] (g3 >= 0): p(u) <= g0 + its positive
-    terms at tau."""
-    return g0 + tau * (max(g1, 0.0) + tau * (0.5 * max(g2, 0.0) + tau * g3 / 6.0)) < 0.0
+    """Quick sufficient test that p < 0 on [0, tau]: p(u) <= g0 + its positive terms at tau."""
+    p3 = tau * g3 / 6.0 if g3 > 0.0 else 0.0  # conditionals, not max(): the hottest test
+    p2 = 0.5 * g2 if g2 > 0.0 else 0.0
+    return g0 + tau * ((g1 if g1 > 0.0 else 0.0) + tau * (p2 + p3)) < 0.0
 
 
 def g3_bound(fm: FlightModel, v: complex, tau: float) -> float:
     """Bound G3 (m^2/s^3) of |g'''| on a free flight of length tau (s) that starts with
-    velocity v (m/s, inertial) and stays inside the clearance (module docstring)."""
+    velocity v (m/s, inertial) and stays inside the clearance (module docstring): 6 V A +
+    2 c_r Jm with V = |v| + K tau, as the polynomial FlightModel.g3_poly in V."""
     V = abs(v) + fm.K * tau
-    A = fm.beta * V + fm.K
-    Jm = fm.beta * A + fm.kappa * V + fm.J
-    return 6.0 * V * A + 2.0 * fm.c_r * Jm + TINY  # rounded up, never 0 by underflow
+    s0, s1, s2 = fm.g3_poly
+    return s0 + V * (s1 + V * s2) + TINY  # rounded up, never 0 by underflow
+
+
+def g3_exact(fm: FlightModel, z: complex, v: complex, acc: complex, E: complex) -> float:
+    """Third derivative g''' (m^2/s^3) of the free flight at (z, v) with z'' = acc (m, m/s,
+    m/s^2, inertial; phasor E = e^{i psi}), exact to rounding."""
+    jerk = fm.jerk(v, acc, E)
+    return 6.0 * (v.conjugate() * acc).real + 2.0 * (z.conjugate() * jerk).real
+
+
+def g3_slack(fm: FlightModel, v: complex, tau: float) -> float:
+    """Slack S (m^2/s^3) with g(s + u) <= g + g' u + g'' u^2/2 + (g''' + S) u^3/6 for u in
+    [0, tau] (s), on a free flight that starts with velocity v (m/s, inertial) and stays
+    inside the clearance: the quartic remainder G4 tau/4, plus the rounding band of the
+    computed g''' (16 eps of G3 = 6 V A + 2 c_r Jm, which bounds its terms; module
+    docstring). G3 and G4 are the polynomials FlightModel.g3_poly and g4_poly in V."""
+    V = abs(v) + fm.K * tau
+    s0, s1, s2 = fm.g3_poly
+    q0, q1, q2 = fm.g4_poly
+    return 0.25 * tau * (q0 + V * (q1 + V * q2)) + 16.0 * EPS * (s0 + V * (s1 + V * s2)) + TINY
 
 
 def flight_is_clear(fm: FlightModel, z: complex, v: complex, E: complex, tau: float) -> bool:
@@ -252,9 +278,7 @@ class ContactLocator:
 
     def g3(self, z: complex, v: complex, E: complex) -> float:
         """Exact third derivative of g (m^2/s^3) of the free flight at (z, v, E)."""
-        acc = self.fm.accel(z, v, E)
-        jerk = self.fm.jerk(v, acc, E)
-        return 6.0 * (v.conjugate() * acc).real + 2.0 * (z.conjugate() * jerk).real
+        return g3_exact(self.fm, z, v, self.fm.accel(z, v, E), E)
 
     def grace_step(self, z: complex, v: complex, E: complex) -> float:
         """Step (s) off the wall for a tangential departure: g, g', g'' zero to resolution
@@ -289,12 +313,14 @@ class ContactLocator:
         s = 0.0
         z, v, E = self.z0, self.v0, self.E0
         wall = on_wall
+        fm, c2, tol_g = self.fm, self.c2, self.tol_g
         for _ in range(MAX_ADVANCES):
-            acc = self.fm.accel(z, v, E)
-            g = (z * z.conjugate()).real - self.c2
-            g1 = 2.0 * (z.conjugate() * v).real
-            g2 = 2.0 * (v * v.conjugate()).real + 2.0 * (z.conjugate() * acc).real
-            if g >= -self.tol_g or (wall and s == 0.0):
+            acc = fm.accel(z, v, E)
+            zc = z.conjugate()
+            g = (z * zc).real - c2
+            g1 = 2.0 * (zc * v).real
+            g2 = 2.0 * (v * v.conjugate()).real + 2.0 * (zc * acc).real
+            if g >= -tol_g or (wall and s == 0.0):
                 bands = self.bands(v)
                 hit = self._at_wall(s, z, v, E, g, g1, g2, bands, work, first=(s == 0.0))
                 if hit is not None:
@@ -308,7 +334,7 @@ class ContactLocator:
             remaining = h - s
             if remaining <= 0.0:
                 return None
-            u = self._advance(g, g1, g2, v, remaining, work)
+            u = self._advance(g, g1, g2, g3_exact(fm, z, v, acc, E), v, remaining, work)
             if u is None:
                 return None
             if u <= 0.0:
@@ -319,21 +345,18 @@ class ContactLocator:
         return Contact(s, z, v, E, "clear")  # proved free of contact up to s; resume there
 
     def _advance(
-        self, g: float, g1: float, g2: float, v: complex, remaining: float, work: Work
+        self, g: float, g1: float, g2: float, g3: float, v: complex, remaining: float,
+        work: Work,
     ) -> float | None:
-        """A safe step (s) from the current point, or None if no contact in `remaining`."""
+        """A safe step (s) from the current point (g and its exact derivatives g1, g2, g3;
+        velocity v), or None if no contact in ``remaining`` (s): the first root of the bound
+        p over tau = min(remaining, horizon), or tau if p has none there. (The plain cubic
+        bound needed a second, shorter tau near a root; here the slack G4 tau/4 is already
+        small beside g3 there, and re-bounding cost more than it saved.)"""
         tau = min(remaining, self.horizon)
-        u = safe_step(g, g1, g2, g3_bound(self.fm, v, tau), tau, work)
+        u = safe_step(g, g1, g2, g3 + g3_slack(self.fm, v, tau), tau, work)
         if u is None:
             return tau if tau < remaining else None
-        for _ in range(2):  # tighten the bound on a shorter interval
-            if u <= 0.0 or u >= 0.25 * tau:
-                break
-            tau = min(remaining, 4.0 * u)
-            u2 = safe_step(g, g1, g2, g3_bound(self.fm, v, tau), tau, work)
-            if u2 is None:
-                return tau if tau < remaining else None
-            u = max(u, u2)
         return u
 
     def _at_wall(

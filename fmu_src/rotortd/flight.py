@@ -57,7 +57,8 @@ class FlightModel:
 
     Besides propagation it provides the bounds the event locator needs: with |z| <= c_r,
     |z''| <= beta |v| + K and |z'''| <= beta |z''| + kappa |v| + J, where
-    K = kappa c_r + |f0| + |F1| (m/s^2) and J = |Omega| |F1| (m/s^3).
+    K = kappa c_r + |f0| + |F1| (m/s^2) and J = |Omega| |F1| (m/s^3); and
+    |z''''| <= beta |z'''| + kappa |z''| + L_rot with L_rot = |Omega| J (m/s^4).
     """
 
     _CACHE_SIZE = 8
@@ -78,6 +79,19 @@ class FlightModel:
         """Slowest decay rate of the transient (1/s); 0 without stiffness or damping."""
         self.K = self.kappa * p.c_r + abs(self.f0) + abs(self.F1)
         self.J = abs(self.Omega) * abs(self.F1)
+        self.L_rot = abs(self.Omega) * self.J
+        """Omega^2 |F1| (m/s^4): the rotating force's term in the bound of |z''''|."""
+        b, k, K, J, c = self.beta, self.kappa, self.K, self.J, p.c_r
+        self.g3_poly = (2.0 * c * (b * K + J), 6.0 * K + 2.0 * c * (b * b + k), 6.0 * b)
+        """(s0, s1, s2): events.g3_bound's 6 V A + 2 c_r Jm = s0 + s1 V + s2 V^2 (m^2/s^3),
+        expanded in the speed bound V (m/s); every coefficient is >= 0."""
+        self.g4_poly = (
+            6.0 * K * K + 2.0 * c * (b * b * K + b * J + k * K + self.L_rot),
+            20.0 * b * K + 8.0 * J + 2.0 * c * (b * b * b + 2.0 * b * k),
+            14.0 * b * b + 8.0 * k,
+        )
+        """(q0, q1, q2): events.g3_slack's 6 A^2 + 8 V Jm + 2 c_r L = q0 + q1 V + q2 V^2
+        (m^2/s^4), expanded in V; every coefficient is >= 0."""
         self.rate = max(abs(self.Omega), self.kappa**0.5, self.beta, (self.K / p.c_r) ** 0.5)
         """Fastest rate of the forced motion (rad/s): |Omega|, sqrt(kappa), beta and
         sqrt(K/c_r), the rate at which the largest force crosses the clearance."""

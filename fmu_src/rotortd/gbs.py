@@ -12,6 +12,9 @@ from collections.abc import Callable, Sequence
 
 Vector = list[float]
 Rhs = Callable[[float, Sequence[float]], Vector]
+Sweep = Callable[[float, Sequence[float], Sequence[float], float, int], Vector]
+"""A modified-midpoint sweep (u0, y0, f0, H, n) -> y(u0 + H): ``midpoint`` with its right-hand
+side bound, or a caller's fused copy of it (contact.Sliding.sweep)."""
 
 SEQUENCE = (2, 4, 6, 8, 10, 12, 14, 16, 18)
 """Substep counts of the modified midpoint rule (the 'double harmonic' sequence)."""
@@ -32,7 +35,7 @@ def midpoint(
 
 
 def extrapolated_step(
-    rhs: Rhs,
+    sweep: Sweep,
     u0: float,
     y0: Sequence[float],
     f0: Sequence[float],
@@ -42,7 +45,7 @@ def extrapolated_step(
     k_max: int = len(SEQUENCE),
     k_fixed: int | None = None,
 ) -> tuple[Vector, float, int, int]:
-    """One extrapolated step of length H.
+    """One extrapolated step of length H from (u0, y0) with f0 = y'(u0).
 
     ``scale[i]`` is the tolerance for component i (components beyond len(scale) are not
     error-controlled). Returns (y, err, k, nfev): err <= 1 means accepted at column k;
@@ -54,19 +57,33 @@ def extrapolated_step(
     k_stop = k_fixed if k_fixed is not None else k_max
     for j in range(k_stop):
         n = SEQUENCE[j]
-        row_new = midpoint(rhs, u0, y0, f0, H, n)
+        extr = [sweep(u0, y0, f0, H, n)]
         nfev += n
-        extr = [row_new]
-        for col in range(1, j + 1):
-            r = (n / SEQUENCE[j - col]) ** 2 - 1.0
-            a, b = extr[col - 1], table[col - 1]
-            extr.append([x + (x - w) / r for x, w in zip(a, b)])
+        for r, b in zip(_RATIOS[j], table):
+            extr.append([x + (x - w) / r for x, w in zip(extr[-1], b)])
         if j >= 1:
-            err = max(abs(extr[j][i] - extr[j - 1][i]) / scale[i] for i in range(len(scale)))
+            err = _error_ratio(extr[j], extr[j - 1], scale)
             if k_fixed is None and j + 1 >= k_min and err <= 1.0:
                 return extr[j], err, j + 1, nfev
         table = extr
     return table[-1], err, k_stop, nfev
+
+
+_RATIOS = tuple(
+    tuple((SEQUENCE[j] / SEQUENCE[j - col]) ** 2 - 1.0 for col in range(1, j + 1))
+    for j in range(len(SEQUENCE))
+)
+"""Aitken–Neville divisors (n_j / n_{j-col})^2 - 1 of row j, columns 1..j."""
+
+
+def _error_ratio(a: Sequence[float], b: Sequence[float], scale: Sequence[float]) -> float:
+    """max_i |a_i - b_i| / scale_i over the controlled components; NaN once any is NaN."""
+    err = 0.0
+    for x, w, s in zip(a, b, scale):
+        e = abs(x - w) / s
+        if e > err or e != e:
+            err = e
+    return err
 
 
 def next_step_size(H: float, err: float, k: int) -> float:

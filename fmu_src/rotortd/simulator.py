@@ -34,14 +34,19 @@ from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from .contact import (
+    QUAD_TOL,
     ContactTally,
     ContactWorkExceeded,
+    LinearRub,
+    QuadraticRub,
     Rolling,
+    RubEquilibrium,
     SegmentEnd,
     Sliding,
     WallForces,
     forward_rub_equilibria,
     phase_integral,
+    rub_deviation,
     wrap_angle,
 )
 from .events import ContactLocator, Work, flight_is_clear
@@ -60,9 +65,15 @@ ETA_TIME = 1e-3
 """Rule (2): rebound flight time below ETA_TIME / w_ref counts as contact (long cascades)."""
 N_CASCADE = 1000
 """Rule (2) applies when more than N_CASCADE impacts would remain before rule (1)."""
-LOCK_TOL = 1e-13
-"""Sliding state within LOCK_TOL (rad, and relative in rate) of a stable forward-rub
-equilibrium is advanced as a rigid rotation."""
+LOCK_TOL = 1e-14
+"""A sliding state on the linearised rub (contact.LinearRub) whose snap_error is at most
+LOCK_TOL is put exactly on the stable forward rub and advanced as a rigid rotation: the
+snap changes the angle, the rate and the normal force by at most LOCK_TOL relative."""
+RUB_RETRY = 4.0
+"""Longest sliding segment, in units of 1/w (WallForces.omega_ref), integrated before the
+linearised rub and the lock are tried again, when a stable forward rub exists. Without it
+a long step integrated all of its sliding, however close to the rub it came (a 10 s step
+at the rub cost 0.19 s CPU)."""
 WORK_BASE = 20_000
 WORK_PER_RADIAN = 100_000
 """Work cap of one step: WORK_BASE + WORK_PER_RADIAN * h * w_max (see work_cap)."""
@@ -210,6 +221,8 @@ class TouchdownCore:
         self._unclear()
         self._roll_lenient = False  # in a step: zero slip proved stuck (_transition)
         self._sticky_at = math.nan  # in a step: where flight and contact swapped at N = 0
+        self._rub_refused = False  # in a step: its start state is not near a rub (_rub_step)
+        self._s_lo = 0.0  # in a step: rounding error of the step-local time (_later), s
         self._n_impacts = 0
         self._t_last = 0.0
         self._v_last = 0.0
@@ -385,14 +398,22 @@ class TouchdownCore:
         if (W, F, a) != self._inputs or self._fm is None:
             self._set_inputs(W, F, a)
         cap = _cap(h, self._w_inputs, abs(self._v) / self._p.c_r)
+        refused = False
         if self._mode == MODE_FREE:
             quick = self._proved_free_step(h, cap)
             if quick is not None:
                 return quick
+        elif self._mode == MODE_SLIDING:
+            quick = self._rub_step(h, cap)
+            if quick is not None:
+                return quick
+            refused = True  # this state is not near a rub: the loop need not ask again
         tally = _Tally()
         work = Work()
         self._roll_lenient = False
         self._sticky_at = math.nan
+        self._s_lo = 0.0
+        self._rub_refused = refused
         rep = StepReport(work_cap=cap)
         t0, s = self._t, 0.0
         try:
@@ -460,6 +481,7 @@ class TouchdownCore:
         self._w_inputs = _input_rate(self._p, W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
         self._wf = WallForces.build(self._p, W, F, a)
+        self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
         self._unclear()
         self._locked = False
 
@@ -486,6 +508,14 @@ class TouchdownCore:
 
     # ------------------------------------------------------------------ free flight
 
+    def _later(self, s: float, ds: float) -> float:
+        """Step-local time s + ds (s), its rounding error kept in _s_lo (2Sum): a long step
+        of many events would otherwise drift by one rounding per event."""
+        t = s + ds
+        r = t - s
+        self._s_lo += (s - (t - r)) + (ds - r)
+        return t
+
     def _phasor(self) -> complex:
         return cmath.exp(1j * self._psi)
 
@@ -500,17 +530,23 @@ class TouchdownCore:
     def _advance_free(self, s: float, h: float, t0: float, tally: _Tally, work: Work) -> float:
         fm = self._fm
         assert fm is not None
-        rem = h - s
+        rem = (h - s) - self._s_lo
         E = self._phasor()
-        if not self._clear and t0 + s >= self._envelope_at:
-            work.evals += 1
+        if not self._clear and not self._on_wall and t0 + s >= self._envelope_at:
+            work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
             self._check_envelope(fm, t0 + s, E)
-        hit = None
+        hit = loc = None
         if not self._clear:
-            hit = ContactLocator(fm, self._z, self._v, E).find(rem, self._on_wall, work)
+            loc = ContactLocator(fm, self._z, self._v, E)
+            hit = loc.find(rem, self._on_wall, work)
         if hit is None:
-            work.evals += 1
-            self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
+            if loc is not None and s > 0.0:
+                # the rest of a step after an event: a length that will not recur, whose
+                # flight map costs twelve times the search's modal state (measured)
+                self._z, self._v, _ = loc.state(rem, work)
+            else:  # a whole step: its length recurs and its flight map is cached
+                work.evals += 1
+                self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
             self._advance_psi(rem)
             self._on_wall = False
             return h
@@ -519,22 +555,24 @@ class TouchdownCore:
         if hit.kind == "clear":
             self._z, self._v = hit.z, hit.v
             self._on_wall = False
-            return s + ds
+            return self._later(s, ds)
         z = hit.z * (self._p.c_r / abs(hit.z))
         self._unclear()
         if hit.kind == "impact":
-            self._impact(t0 + s + ds, z, hit.v, tally)
+            self._impact(t0 + s + (self._s_lo + ds), z, hit.v, tally)
         else:
             self._z, self._v = z, hit.v
             self._enter_contact()
-        return s + ds if ds > 0.0 else s + 0.0
+        return self._later(s, ds)
 
     def _check_envelope(self, fm: FlightModel, t: float, E: complex) -> None:
         """Try to prove the flight clear of the wall for all time under the held inputs
         (``_clear``). If that fails, schedule the next try for when the transient bound,
         decaying like e^{-decay_rate t}, could have fallen below the margin left by the
         steady whirl; never, if the steady whirl alone reaches the wall. The schedule only
-        saves work: a flight that is not proved clear is searched, which is always exact."""
+        saves work: a flight that is not proved clear is searched, which is always exact.
+        Not tried from the wall (after an impact or lift-off): sup |z| >= |z(0)| = c_r there,
+        so the proof must fail; the next step that starts off the wall tries again."""
         steady, transient = fm.radius_bound_parts(self._z, self._v, E)
         limit = self._p.c_r * _R_CLEAR
         if steady + transient < limit:
@@ -637,8 +675,7 @@ class TouchdownCore:
     def _advance_contact(self, s: float, h: float, tally: _Tally, work: Work) -> float:
         wf = self._wf
         assert wf is not None
-        p = self._p
-        rem = h - s
+        rem = (h - s) - self._s_lo
         E = self._phasor()
         vrel = wf.wr + self._dtheta
         if (self._mode == MODE_ROLLING and vrel != 0.0) or (
@@ -652,20 +689,42 @@ class TouchdownCore:
         if self._mode == MODE_ROLLING:
             slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if self._roll_lenient else 0.0
             end = Rolling(wf, self._theta, E).run(rem, cone_slack=slack)
-        elif self._try_lock(E):
-            end = self._locked_rotation(rem, E)
-        else:
+        elif (end := self._rub_segment(rem, E, self._may_linearise(s, sticky))) is None:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
             end, self._H = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack).run(
-                rem, self._H if math.isfinite(self._H) else 0.05 / wf.omega_ref(self._dtheta)
+                self._slide_span(rem),
+                self._H if math.isfinite(self._H) else 0.05 / wf.omega_ref(self._dtheta),
             )
         work.iters += end.tally.work
+        self._end_segment(end, tally)
+        return self._later(s, end.du) if end.du < rem else h
+
+    def _end_segment(self, end: SegmentEnd, tally: _Tally) -> None:
+        """Take the state, contact integrals and event at the end of a contact segment."""
+        p = self._p
         tally.add_contact(end.tally, p.m * p.c_r, p.c_r)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_psi(end.du)
         self._transition(end.event)
         self._sync_from_contact()
-        return s + end.du if end.du < rem else h
+
+    def _rub_step(self, h: float, cap: int) -> StepReport | None:
+        """A sliding step on or near a stable forward rub in closed form, without the step
+        loop: the rigid rotation when locked, else the linearised motion when the state
+        admits it (``_linear_rub``); None otherwise (the caller integrates). The inputs
+        are those the rub was found under (new inputs unlock it). ``_advance_contact``
+        would take the same segment whole: the slip sign agrees with v_rel, and Gn stays
+        above the lift-off test (constant on the rotation; bounded below by
+        LinearRub.near on the linearised motion)."""
+        end = self._rub_segment(h, self._phasor(), True)
+        if end is None:
+            return None
+        tally = _Tally()
+        self._end_segment(end, tally)
+        self._tick(h)
+        rep = StepReport(work_cap=cap)
+        self._fill_report(rep, tally, Work(iters=end.tally.work), h)
+        return rep
 
     def _leaves_wall(self, E: complex) -> bool:
         """Lift-off at the start of a contact segment: N < 0, or N = 0 to rounding and
@@ -709,23 +768,63 @@ class TouchdownCore:
         self._locked = False
         self._unclear()
 
-    def _try_lock(self, E: complex) -> bool:
-        """True when the state sits on a stable forward-rub equilibrium (then lock it)."""
+    def _lock(self, lin: LinearRub | QuadraticRub, rem: float, E: complex) -> SegmentEnd:
+        """Put the state on the rub of ``lin`` (lock it) and rotate rigidly for rem s."""
+        self._theta = wrap_angle(lin.eq.alpha + cmath.phase(E))
+        self._dtheta = lin.wf.Omega
+        self._locked = True
+        return self._locked_rotation(rem, E)
+
+    def _rub_equilibria(self) -> list[RubEquilibrium]:
+        """forward_rub_equilibria of the held inputs (computed once per inputs)."""
+        if self._rub_eqs is None:
+            assert self._wf is not None
+            self._rub_eqs = forward_rub_equilibria(self._wf)
+        return self._rub_eqs
+
+    def _rub_segment(self, rem: float, E: complex, linearise: bool) -> SegmentEnd | None:
+        """A sliding segment of rem s on or near a stable forward rub in closed form: the
+        rigid rotation when locked; else, if ``linearise``, the linearised motion when the
+        state admits it (locking first when the snap is below LOCK_TOL); else None."""
         if self._locked:
-            return True
+            return self._locked_rotation(rem, E)
+        lin = self._linear_rub(E) if linearise else None
+        if lin is None:
+            return None
+        return self._lock(lin, rem, E) if lin.snap_error() <= LOCK_TOL else lin.run(rem)
+
+    def _slide_span(self, rem: float) -> float:
+        """How long (s) to integrate sliding before the rub's closed form is tried again:
+        rem, or RUB_RETRY/w if shorter when a stable forward rub exists."""
         wf = self._wf
         assert wf is not None
-        W = wf.Omega
-        if wf.q0 != 0 or abs(self._dtheta - W) > LOCK_TOL * abs(W):
-            return False
-        alpha = wrap_angle(self._theta - cmath.phase(E))
-        for eq in forward_rub_equilibria(wf):
-            if eq.stable and abs(wrap_angle(alpha - eq.alpha)) <= LOCK_TOL:
-                self._theta = wrap_angle(eq.alpha + cmath.phase(E))
-                self._dtheta = W
-                self._locked = True
-                return True
-        return False
+        if any(eq.stable for eq in self._rub_equilibria()):
+            return min(rem, RUB_RETRY / wf.omega_ref(self._dtheta))
+        return rem
+
+    def _may_linearise(self, s: float, sticky: bool) -> bool:
+        """May a sliding segment starting s seconds into the step try the linearised rub?
+        Not when sticky, nor at the step's start when _rub_step has refused that state."""
+        refused, self._rub_refused = self._rub_refused and s == 0.0, False
+        return not (sticky or refused)
+
+    def _linear_rub(self, E: complex) -> LinearRub | QuadraticRub | None:
+        """The closed-form sliding near a stable forward rub: linearised when within
+        LINEAR_TOL and its error budget holds (LinearRub.near), else to second order when
+        within QUAD_TOL and its budget holds (QuadraticRub.near); None otherwise."""
+        wf = self._wf
+        assert wf is not None
+        th, dth, slip = self._theta, self._dtheta, self._slip
+        for eq in self._rub_equilibria():  # (none when q0 != 0)
+            dev = rub_deviation(wf, eq, th, dth, E, slip, QUAD_TOL)
+            if dev is None:
+                continue
+            lin = LinearRub.admit(wf, eq, th, dth, slip, dev)
+            if lin is None:
+                lin = QuadraticRub.admit(wf, eq, th, dth, slip, dev)
+            if lin is not None:
+                return lin
+        return None
 
     def _locked_rotation(self, rem: float, E: complex) -> SegmentEnd:
         """Closed-form synchronous rub over rem seconds (theta' = Omega, Gn constant)."""
