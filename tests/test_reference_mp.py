@@ -454,6 +454,23 @@ def test_sliding_frictionless_energy_conserved() -> None:
         assert abs(energy(out["theta"], out["dtheta"]) / e0 - 1) < 1e-35
 
 
+def test_sliding_impulse_balances_momentum() -> None:
+    """AMB off, no imbalance: the only forces are the constant P = F_ext - i m g and the
+    contact, so the reference's contact impulse must equal m (v(t) - v(0)) - P t."""
+    p = par(e_c=0.0, mu=0.3)
+    F = 200.0 + 100.0j
+    th0, w0, t = 0.5, 300.0, 0.02
+    out = mp_sliding(p, th0, w0, 0.0, OMEGA, F, 0.0, t)
+    assert out["event"] == "t_end"
+    with mp.workdps(55):
+        cr, m = mp.mpf(C_R), mp.mpf(p["m"])
+        P = mp.mpc(F) - 1j * m * p["g"]
+        dv = 1j * cr * (out["dtheta"] * mp.expj(out["theta"]) - w0 * mp.expj(mp.mpf(th0)))
+        expect = m * dv - P * t
+        assert abs(out["I_c"] - expect) < 1e-30 * abs(expect)
+        assert out["I_n"] > 0
+
+
 def test_sliding_frictionless_imbalance_pendulum() -> None:
     """μ = 0, no constant force, c = 0: α = θ - Ωt - ψ0 - φ obeys α'' = -(e_c Ω²/c_r) sin α,
     so ½ α'² - (e_c Ω²/c_r) cos α is conserved."""

@@ -67,6 +67,10 @@ OMEGA = 184.2
 """Spin speed (rad/s), the FMU input's start value, held constant in every scene."""
 ETA_HEIGHT = 1e-14
 """Low-speed rule (1) threshold on the rebound height, in c_r (docs/model.md §6)."""
+CUTOFF_NEAR = 2.0
+"""Impacts with rdot- <= CUTOFF_NEAR v_stop have their cut-off speed recorded in the
+reference (``cutoffs`` in <Scene>_par.json): the validation needs it to tell whether the
+FMU's own speed error at that impact reaches across the cut-off (tests/validation_lib.py)."""
 PERTURBATION = 1e-12
 """Scaled perturbation of the initial state for the sensitivity (c_r, c_r Omega)."""
 REF_STEP = 1e-3
@@ -282,16 +286,19 @@ def _mp_par(sc: Scene) -> dict[str, Any]:
     return {**{k: sc.par[k] for k in PAR_KEYS}, "levitate": sc.par.get("levitate", True)}
 
 
-def _low_speed_plastic(sc: Scene, a: float, t: Any, imp: dict[str, Any]) -> bool:
-    """Rule (1) of the low-speed rule, evaluated in mpmath (see the module docstring)."""
+def _low_speed_cutoff(sc: Scene, a: float, t: Any, imp: dict[str, Any]) -> Any:
+    """Rule (1) of the low-speed rule, evaluated in mpmath (see the module docstring): the
+    cut-off speed v_stop = sqrt(2 A ETA_HEIGHT c_r)/d (m/s) at this impact, at or below which
+    it is plastic (inf for d = 0: no rebound); None where A <= 0 (no contact possible)."""
     A = _outward_accel(sc, a, t, imp["z"], imp["v_plus"])
     if A <= 0:
-        return False
+        return None
     d = mp.mpf(sc.par["d"])
-    vb = d * imp["rdot"]
+    if d == 0:
+        return mp.inf
     if d >= mp.mpf("0.99") and imp["rdot"] < mp.mpf(1e-3) * sc.par["c_r"] * OMEGA:
         raise NotImplementedError("low-speed rule (2) regime (d close to 1) not modelled")
-    return vb * vb <= 2 * A * ETA_HEIGHT * mp.mpf(sc.par["c_r"])
+    return mp.sqrt(2 * A * ETA_HEIGHT * mp.mpf(sc.par["c_r"])) / d
 
 
 def _free_to(sc: Scene, run: MpRun, st: MpState, a: float, t_stop: Any, dps: int) -> MpState:
@@ -305,7 +312,9 @@ def _free_to(sc: Scene, run: MpRun, st: MpState, a: float, t_stop: Any, dps: int
         imp = dict(res["impacts"][0])
         t_imp = st.t + imp["t"]
         imp["t"] = t_imp
-        if _low_speed_plastic(sc, a, t_imp, imp):
+        v_stop = _low_speed_cutoff(sc, a, t_imp, imp)
+        imp["v_stop"] = v_stop
+        if v_stop is not None and imp["rdot"] <= v_stop:
             plastic = M.mp_reset({**par, "d": 0.0}, imp["z"], imp["v_minus"], OMEGA, dps=dps)
             imp["v_plus"] = plastic["v_plus"]
             imp["plastic"] = True
@@ -431,12 +440,13 @@ def _scaled_diff(sc: Scene, a: dict[str, Any], b: dict[str, Any]) -> dict[str, A
             "vp": dvp, "s": ds.tolist()}
 
 
-def sensitivity(sc: Scene, grid: np.ndarray) -> dict[str, Any]:
+def sensitivity(sc: Scene, grid: np.ndarray, n_ref: int) -> dict[str, Any]:
     """Amplification of a PERTURBATION (scaled) of the initial state, 8 directions.
 
     Directions: +-1e-12 c_r on x and y, +-1e-12 c_r Omega on vx and vy. Amplification of a
     quantity = max over directions of |difference| (scaled) / 1e-12. Impacts are matched by
-    index; an impact beyond the shorter list (the count changed) gets ``None``.
+    index; an impact beyond the shorter list (the count changed) gets ``None``, and so does
+    every reference impact (``n_ref`` of them) beyond the float64 nominal run's own count.
     """
     c_r = sc.par["c_r"]
     nominal = core_run(sc, sc.z0, sc.v0, grid)
@@ -452,6 +462,8 @@ def sensitivity(sc: Scene, grid: np.ndarray) -> dict[str, Any]:
             for key in ("t", "z", "vm", "vp", "s"):
                 amp[key] = _max_amp(amp.get(key), diff[key], len(nominal["impacts"])
                                     if key != "s" else len(grid))
+    for key in ("t", "z", "vm", "vp"):
+        amp[key] = (amp[key] + [None] * n_ref)[:n_ref]
     amp["counts"] = counts
     amp["end"] = amp["s"][-1]
     amp["max"] = max(x for key in ("t", "z", "vm", "vp", "s") for x in amp[key]
@@ -536,7 +548,7 @@ def make_scene(sc: Scene, dps: int = 40) -> dict[str, Any]:
     d_rows, d_imps, d_status = _direct_files(sc, grid)
     write_csv(out / f"{sc.name}_direct.csv", ["time", "x", "y", "vx", "vy", "mode"], d_rows)
     write_csv(out / f"{sc.name}_direct_impacts.csv", IMPACT_COLS, d_imps)
-    sens = sensitivity(sc, grid)
+    sens = sensitivity(sc, grid, len(run.impacts))
     (out / f"{sc.name}_sens.json").write_text(json.dumps(sens, indent=1))
     _write_meta(sc, run, dps, d_status, time.perf_counter() - t0, t_mp)
     return {"scene": sc.name, "impacts": len(run.impacts), "events": run.events,
@@ -548,10 +560,14 @@ def _write_meta(sc: Scene, run: MpRun, dps: int, d_status: str, secs: float, t_m
                 ) -> None:
     """<Scene>_par.json, <Scene>_ref.opt and (if inputs vary) <Scene>_in.csv."""
     plastic = [i for i, imp in enumerate(run.impacts) if imp.get("plastic")]
+    cutoffs = [[i, float(imp["v_stop"])] for i, imp in enumerate(run.impacts)
+               if imp.get("v_stop") is not None and mp.isfinite(imp["v_stop"])
+               and imp["rdot"] <= CUTOFF_NEAR * imp["v_stop"]]
     meta = {"name": sc.name, "description": sc.description, "start_values": sc.start_values(),
             "Omega": OMEGA, "stop_time": sc.stop, "amb_off": sc.amb_off,
             "reference": {"dps": dps, "eta_height": ETA_HEIGHT, "n_impacts": len(run.impacts),
-                          "plastic_impacts": plastic, "contact_events": run.events,
+                          "plastic_impacts": plastic, "cutoffs": cutoffs,
+                          "contact_events": run.events,
                           "direct_status": d_status, "seconds": round(secs, 1),
                           "mp_seconds": round(t_mp, 1)}}
     (SCENE_DIR / f"{sc.name}_par.json").write_text(json.dumps(meta, indent=1))

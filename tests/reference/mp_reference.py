@@ -694,7 +694,9 @@ def mp_sliding(
     Stops at the first of: ``t_end``; lift-off (N reaches 0 while decreasing; also
     at t = 0 if ``N(0) < 0``); slip reversal ``v_rel = 0`` (stick/rolling onset).
     Returns dict ``theta, dtheta, t, lift_off (bool), N_end`` (N at the returned
-    time, N) and ``event`` in {"t_end", "lift_off", "v_rel_zero"}.
+    time, N), ``event`` in {"t_end", "lift_off", "v_rel_zero"}, and the impulses over
+    [0, t]: ``I_n`` (the integral of N, N s) and ``I_c`` (of the contact force on the rotor,
+    ``-(N + i μ s N) e^{iθ}``, complex, N s, inertial), from the integrated Taylor series.
     """
     with mp.workdps(dps + GUARD_DIGITS):
         model = _ContactModel(par, psi0, Omega, F_ext, a)
@@ -705,10 +707,11 @@ def mp_sliding(
             raise ValueError("v_rel = 0 at the start: rolling, not sliding")
         N0 = model.normal_force(t, th, om)
         if N0 < 0:
-            return _slide_result(th, om, t, N0, "lift_off")
+            return _slide_result(th, om, t, N0, "lift_off", (mp.zero, mp.zero))
         order = dps + GUARD_DIGITS
         tol = mp.mpf(10) ** -(dps + GUARD_DIGITS)
         vr_off = model.p["R"] * model.Omega / model.p["c_r"]
+        imp = (mp.zero, mp.mpc(0))
         while True:
             ths, oms, Ns = model.series(t, th, om, s, order)
             h = _step_size(ths, oms, model.rate_scale(om), tol)
@@ -717,12 +720,31 @@ def mp_sliding(
             ev_n = _first_event(Ns, h, 1)
             ev_v = _first_event(oms, h, s, offset=vr_off)
             event, sig = _earliest(ev_n, ev_v, h)
+            imp = _add_impulses(imp, model, ths, Ns, s, sig)
             th, om = _horner(ths, sig), _horner(oms, sig)
             if event != "t_end":
-                return _slide_result(th, om, t + sig, _horner(Ns, sig), event)
+                return _slide_result(th, om, t + sig, _horner(Ns, sig), event, imp)
             t = t_end if last else t + h
             if last:
-                return _slide_result(th, om, t, model.normal_force(t, th, om), "t_end")
+                N_end = model.normal_force(t, th, om)
+                return _slide_result(th, om, t, N_end, "t_end", imp)
+
+
+def _add_impulses(
+    imp: tuple[Num, Num], model: _ContactModel, ths: list[Num], Ns: list[Num], s: int,
+    sig: Num,
+) -> tuple[Num, Num]:
+    """(I_n, I_c) plus the integrals over [0, sig] of a step's series of N and of the
+    contact force -(1 + i μ s) N e^{iθ}, with e^{iθ} = Σ E_k σ^k by E' = i θ' E."""
+    j_ = mp.mpc(0, 1)
+    E = [mp.expj(ths[0])]
+    for k in range(1, len(ths)):
+        E.append(j_ / k * mp.fsum(i * ths[i] * E[k - i] for i in range(1, k + 1)))
+    fc = [mp.fsum(Ns[i] * E[k - i] for i in range(k + 1)) for k in range(len(Ns))]
+    lead = -(1 + j_ * model.p["mu"] * s)
+    I_n = _horner([mp.zero] + [c / (k + 1) for k, c in enumerate(Ns)], sig)
+    I_c = lead * _horner([mp.mpc(0)] + [c / (k + 1) for k, c in enumerate(fc)], sig)
+    return imp[0] + I_n, imp[1] + I_c
 
 
 def _earliest(ev_n: Num | None, ev_v: Num | None, h: Num) -> tuple[str, Num]:
@@ -738,7 +760,9 @@ def _earliest(ev_n: Num | None, ev_v: Num | None, h: Num) -> tuple[str, Num]:
     return name, sig
 
 
-def _slide_result(th: Num, om: Num, t: Num, N: Num, event: str) -> dict[str, Any]:
+def _slide_result(
+    th: Num, om: Num, t: Num, N: Num, event: str, imp: tuple[Num, Num]
+) -> dict[str, Any]:
     """Assemble the result dict of :func:`mp_sliding`."""
     return {
         "theta": th,
@@ -747,6 +771,8 @@ def _slide_result(th: Num, om: Num, t: Num, N: Num, event: str) -> dict[str, Any
         "lift_off": event == "lift_off",
         "N_end": N,
         "event": event,
+        "I_n": imp[0],
+        "I_c": imp[1],
     }
 
 
