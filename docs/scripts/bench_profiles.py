@@ -2,7 +2,8 @@
 
     python docs/scripts/bench_profiles.py > docs/bench_profiles.txt
 
-1. the core on the impacting limit cycle (gamma = 0.1), 1 s in steps of 1e-3 s, 5 runs;
+1. the core on the impacting limit cycle (gamma = 0.1), 1 s in steps of 1e-3 s, 5 runs, and
+   on the chattering scene (gamma = 0.3 from rest), the same;
 2. the FMU in a lean FMU2Slave loop (free whirl, all outputs read every step), 1000 steps;
 3. the same loop on the overhead-floor FMU;
 4. a CPU-time split of one FMU step (process_time, medians of 5).
@@ -42,6 +43,11 @@ def core_limit_cycle() -> None:
             core.step(1e-3, OMEGA)
 
 
+def core_scene(sc: bm.Scene) -> None:
+    for _ in range(5):
+        bm.run_core(sc)
+
+
 def cpu(fn: object, reps: int = 5) -> float:
     times = []
     for _ in range(reps):
@@ -77,6 +83,9 @@ def split(fmus: dict, sc: bm.Scene) -> None:
 
 def main() -> None:
     profile("core, limit cycle gamma = 0.1, 5 x 1000 steps of 1e-3 s", core_limit_cycle)
+    chatter = next(s for s in bm.make_scenes() if s.name == "chattering")
+    profile("core, chattering into rub gamma = 0.3, 5 x 1000 steps of 1e-3 s",
+            lambda: core_scene(chatter))
     tmp = Path(tempfile.mkdtemp(prefix="rotortd_prof_"))
     fmus = bm.build_fmus(tmp)
     sc = next(s for s in bm.make_scenes() if s.name == "free_whirl")

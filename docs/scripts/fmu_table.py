@@ -15,6 +15,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
+from mdblock import replace_block  # noqa: E402 (docs/scripts/mdblock.py)
+
 from build import variable_rows  # noqa: E402
 
 COLUMNS = ("name", "type", "causality", "variability", "start", "unit", "min", "max",
@@ -32,15 +34,6 @@ def markdown_table(fmu: Path) -> str:
     return "\n".join(lines)
 
 
-BEGIN, END = "<!-- BEGIN fmu_table -->", "<!-- END fmu_table -->"
-
-
-def update_markdown(doc: Path, table: str) -> None:
-    text = doc.read_text(encoding="utf-8")
-    start, end = text.index(BEGIN) + len(BEGIN), text.index(END)
-    doc.write_text(text[:start] + "\n" + table + "\n" + text[end:], encoding="utf-8")
-
-
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("fmu", nargs="?", type=Path,
@@ -49,7 +42,7 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     table = markdown_table(args.fmu)
     if args.update:
-        update_markdown(args.update, table)
+        replace_block(args.update, "fmu_table", table)
         print(f"fmu_table: updated {args.update}")
     else:
         print(table)
