@@ -16,6 +16,7 @@ from rotortd.events import (
     flight_is_clear,
     g3_exact,
     g3_slack,
+    safe_step,
 )
 from rotortd.flight import FlightModel
 
@@ -135,6 +136,73 @@ def _random_flight(rng: random.Random) -> tuple[FlightModel, complex, complex, c
     v0 = cmath.rect(p.c_r * abs(W) * rng.uniform(0.0, 2.0), rng.uniform(-math.pi, math.pi))
     E0 = cmath.exp(1j * rng.uniform(-math.pi, math.pi))
     return fm, z0, v0, E0, 10 ** rng.uniform(-6.0, -1.0)
+
+
+def _composed_find(loc: ContactLocator, h: float, on_wall: bool, work: Work):
+    """ContactLocator.find written through the helpers its inline loop copies (accel,
+    g3_exact, g3_slack, safe_step, state): the oracle of the bit-identity test below."""
+    s, (z, v, E), fm = 0.0, (loc.z0, loc.v0, loc.E0), loc.fm
+    for _ in range(400):
+        acc = fm.accel(z, v, E)
+        zc = z.conjugate()
+        g = (z * zc).real - loc.c2
+        g1 = 2.0 * (zc * v).real
+        g2 = 2.0 * (v * v.conjugate()).real + 2.0 * (zc * acc).real
+        if g >= -loc.tol_g or (on_wall and s == 0.0):
+            bands = loc.bands(v)
+            hit = loc._at_wall(s, z, v, E, g, g1, g2, bands, work, first=(s == 0.0))
+            if hit is not None:
+                return hit
+            g, g1 = 0.0, min(g1, 0.0)
+            if g1 >= -bands[0] and g2 >= -bands[1] and s < h:
+                s = min(h, s + loc.grace_step(z, v, E))
+                z, v, E = loc.state(s, work)
+                continue
+        remaining = h - s
+        if remaining <= 0.0:
+            return None
+        tau = min(remaining, loc.horizon)
+        u = safe_step(g, g1, g2, g3_exact(fm, z, v, acc, E) + g3_slack(fm, v, tau), tau, work)
+        if u is None:
+            if tau >= remaining:
+                return None
+            u = tau
+        if u <= 0.0:
+            return ("touch", s, z, v, E)
+        s = s + u if u < remaining else h
+        z, v, E = loc.state(s, work)
+    return ("clear", s, z, v, E)
+
+
+def _as_tuple(hit) -> tuple | None:
+    return hit if hit is None or isinstance(hit, tuple) else (hit.kind, hit.s, hit.z, hit.v,
+                                                                 hit.E)
+
+
+def test_inline_search_loop_is_bit_identical_to_its_helpers() -> None:
+    """find evaluates points, bounds and the quick test inline (the core's hottest loop).
+    On 1500 random flights, from inside and from the wall, with modes and without (k = 0),
+    it returns the same contact, bit for bit, with the same work count as the loop
+    composed of the helpers, so the helpers' tests (the bound above the exact flight, the
+    quick test) speak for the inline copy. Contacts of every kind must occur."""
+    rng = random.Random(20261123)
+    kinds: dict[str, int] = {}
+    for j in range(1500):
+        fm, z0, v0, E0, h = _random_flight(rng)
+        if j % 5 == 0:  # no stiffness: no modes, points by the divided-difference map
+            fm = FlightModel(fm.params.replace(k=0.0), fm.Omega, fm.F_ext, fm.amb)
+        on_wall = j % 3 == 0
+        if on_wall:
+            z0 = fm.c_r * z0 / abs(z0) if z0 else complex(fm.c_r)
+        h = 10 * h
+        w1, w2 = Work(), Work()
+        got = _as_tuple(ContactLocator(fm, z0, v0, E0).find(h, on_wall, w1))
+        want = _as_tuple(_composed_find(ContactLocator(fm, z0, v0, E0), h, on_wall, w2))
+        assert got == want, (j, got, want)
+        assert (w1.evals, w1.iters) == (w2.evals, w2.iters), j
+        kind = "none" if got is None else got[0]
+        kinds[kind] = kinds.get(kind, 0) + 1
+    assert kinds.get("impact", 0) > 100 and kinds.get("none", 0) > 100, kinds
 
 
 def test_flight_proved_clear_never_reaches_the_wall() -> None:
