@@ -676,7 +676,32 @@ def _rub_propagator(a1: float, sig: float, u: float) -> tuple[float, float]:
     return decay * ch, decay * s_
 
 
-class LinearRub:
+class _RubStep:
+    """What LinearRub and QuadraticRub share: ``near`` measures the deviation of a sliding
+    state from the rub with the class's DEV_TOL (``rub_deviation``) and hands it to the
+    class's ``admit``, which weighs the dropped terms against LINEAR_BUDGET."""
+
+    __slots__ = ()
+    DEV_TOL: float
+
+    @classmethod
+    def near(
+        cls, wf: WallForces, eq: RubEquilibrium, theta0: float, dtheta0: float, E0: complex,
+        s: float,
+    ) -> _RubStep | None:
+        """The closed-form rub step from (theta0, dtheta0) with e^{i psi} = E0 and slip sign
+        s, or None when the state is not close enough (the class docstring)."""
+        dev = rub_deviation(wf, eq, theta0, dtheta0, E0, s, cls.DEV_TOL)
+        return None if dev is None else cls.admit(wf, eq, theta0, dtheta0, s, dev)
+
+    @classmethod
+    def admit(cls, wf: WallForces, eq: RubEquilibrium, theta0: float, dtheta0: float,
+              s: float, dev: tuple[float, ...]) -> _RubStep | None:
+        """``near`` on a state's ``rub_deviation``: the step, or None (the class docstring)."""
+        raise NotImplementedError
+
+
+class LinearRub(_RubStep):
     """Sliding within LINEAR_TOL of a stable forward rub ``eq`` (q0 = 0), in closed form.
 
     Frame: co-rotating, SI. The deviation x = theta - psi - alpha (rad) and y = theta' -
@@ -692,22 +717,13 @@ class LinearRub:
     """
 
     __slots__ = ("X", "Y", "eq", "gx", "mus", "theta0", "wf", "x0", "y0")
+    DEV_TOL = LINEAR_TOL
 
     def __init__(self, wf: WallForces, eq: RubEquilibrium, theta0: float, x0: float,
                  y0: float, mus: float, X: float, Y: float, gx: float) -> None:
         self.wf, self.eq, self.theta0, self.x0, self.y0, self.mus = wf, eq, theta0, x0, y0, mus
         self.X, self.Y = X, Y  # bounds of |x| (rad) and |y| (rad/s) from now on
         self.gx = gx  # dGn/dx at the rub (1/s^2); dGn/dy = 2 Omega
-
-    @classmethod
-    def near(
-        cls, wf: WallForces, eq: RubEquilibrium, theta0: float, dtheta0: float, E0: complex,
-        s: float,
-    ) -> LinearRub | None:
-        """The linearised rub from (theta0, dtheta0) with e^{i psi} = E0 and slip sign s, or
-        None when the state is not close enough (the class docstring)."""
-        dev = rub_deviation(wf, eq, theta0, dtheta0, E0, s, LINEAR_TOL)
-        return None if dev is None else cls.admit(wf, eq, theta0, dtheta0, s, dev)
 
     @classmethod
     def admit(
@@ -776,7 +792,7 @@ QUAD_TOL = 1e-4
 ``QuadraticRub.near`` weighs its errors against LINEAR_BUDGET."""
 
 
-class QuadraticRub:
+class QuadraticRub(_RubStep):
     """Sliding near a stable forward rub ``eq`` (q0 = 0) to second order, in closed form.
 
     Frame: co-rotating, SI; x, y, a1, b1, gx, X, Y, Ix, Iy as in LinearRub. Exactly,
@@ -801,22 +817,13 @@ class QuadraticRub:
     """
 
     __slots__ = ("eq", "k2", "mus", "pr", "theta0", "wf", "x0", "y0")
+    DEV_TOL = QUAD_TOL
 
     def __init__(self, wf: WallForces, eq: RubEquilibrium, theta0: float, x0: float,
                  y0: float, mus: float, k2: float, pr: tuple[float, ...]) -> None:
         self.wf, self.eq, self.theta0, self.x0, self.y0 = wf, eq, theta0, x0, y0
         self.mus, self.k2 = mus, k2  # mu times the slip sign; k2 (1/s^2)
         self.pr = pr  # (p1, p2, p3, r1, r2, r3): x2 = p.Q (s^2), y2 = r.Q (s)
-
-    @classmethod
-    def near(
-        cls, wf: WallForces, eq: RubEquilibrium, theta0: float, dtheta0: float, E0: complex,
-        s: float,
-    ) -> QuadraticRub | None:
-        """The second-order rub from (theta0, dtheta0) with e^{i psi} = E0 and slip sign s,
-        or None when its third-order errors are not provably below LINEAR_BUDGET."""
-        dev = rub_deviation(wf, eq, theta0, dtheta0, E0, s, QUAD_TOL)
-        return None if dev is None else cls.admit(wf, eq, theta0, dtheta0, s, dev)
 
     @classmethod
     def admit(
