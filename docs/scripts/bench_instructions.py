@@ -1,6 +1,6 @@
 """Deterministic cost figures: instructions counted by valgrind's callgrind.
 
-    apt-get install valgrind && python docs/scripts/bench_instructions.py   # ~15 min
+    apt-get install valgrind && python docs/scripts/bench_instructions.py   # ~5 min
 
 Timed ratios on a shared machine scatter (docs/benchmarks.md). Instruction counts do not,
 so this script counts them for the ratios that sit near their goals:
