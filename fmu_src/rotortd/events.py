@@ -187,6 +187,13 @@ def safe_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
         g0, g1, g2, g3 = _unit_scale(g0, g1, g2, g3)
     if g0 < 0.0 and _negative_throughout(g0, g1, g2, g3, tau):
         return None  # the common case, quickly
+    return _first_root_step(g0, g1, g2, g3, tau, work)
+
+
+def _first_root_step(g0: float, g1: float, g2: float, g3: float, tau: float, work: Work
+                     ) -> float | None:
+    """safe_step after its quick test failed (coefficients already rescaled): the left end
+    of the bracket of p's first root in (0, tau], or None when p < 0 throughout."""
     if g0 == 0.0:
         return _safe_step_on_wall(g1, g2, g3, tau, work)
     knots = [0.0, *_critical_points(g1, g2, g3, tau), tau]
@@ -378,13 +385,14 @@ class ContactLocator:
                 p2 = 0.5 * g2 if g2 > 0.0 else 0.0
                 quiet = g + tau * ((g1 if g1 > 0.0 else 0.0) + tau * (p2 + p3)) < 0.0
             else:
-                quiet = False
+                quiet = None  # not tested here: safe_step rescales and tests
             if quiet:  # no contact within tau
                 if tau >= remaining:
                     return None
                 s = s + tau
             else:
-                u = safe_step(g, g1, g2, c3, tau, work)
+                u = (safe_step(g, g1, g2, c3, tau, work) if quiet is None
+                     else _first_root_step(g, g1, g2, c3, tau, work))
                 if u is None:
                     if tau >= remaining:
                         return None
