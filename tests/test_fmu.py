@@ -16,6 +16,7 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 import pytest
+from rotortd.limits import LIMITS
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = Path(__file__).resolve().parent / "fmu_scenarios.py"
@@ -82,7 +83,9 @@ def test_model_description_units_structure_and_flags(fmu_path: Path) -> None:
     assert outputs == expected
     by_name = {sv.get("name"): sv for sv in variables}
     assert by_name["d"][0].get("max") == "1.0"
-    assert by_name["m"][0].get("min") == "0.0"
+    for name, lim in LIMITS.items():  # the ranges the core's limits table states
+        assert by_name[name][0].get("min") == repr(lim.lo), name
+        assert by_name[name][0].get("max") == repr(lim.hi), name
     assert by_name["c"].get("variability") == "tunable"
     assert by_name["m"].get("variability") == "fixed"
     with zipfile.ZipFile(fmu_path) as zf:

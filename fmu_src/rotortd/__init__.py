@@ -7,6 +7,7 @@ The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``To
 
 from .contact import RubEquilibrium, WallForces, forward_rub_equilibria
 from .impact import Impact
+from .limits import LIMITS, CrossParameterError, Limit
 from .params import TUNABLE, InputError, ParameterError, RotorParams, ScaledParams
 from .simulator import (
     MODE_FREE,
@@ -21,15 +22,18 @@ from .simulator import (
 )
 
 __all__ = [
+    "LIMITS",
     "MODE_FREE",
     "MODE_ROLLING",
     "MODE_SLIDING",
     "STATUS_OK",
     "STATUS_WORK_CAP",
     "TUNABLE",
+    "CrossParameterError",
     "Impact",
     "InputError",
     "Kinematics",
+    "Limit",
     "ParameterError",
     "RotorParams",
     "RubEquilibrium",

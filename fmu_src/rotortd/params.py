@@ -9,13 +9,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
+from .limits import CrossParameterError, InputError, ParameterError
 
-class ParameterError(ValueError):
-    """A parameter or initial state is invalid; the message names it and its allowed range."""
-
-
-class InputError(ValueError):
-    """An input held over a step (or the step length) is invalid; the message names it."""
+__all__ = ["CrossParameterError", "InputError", "ParameterError"]
 
 
 def check_finite(name: str, value: float, error: type[ValueError] = ParameterError) -> float:
@@ -68,7 +64,9 @@ class ScaledParams:
 
 @dataclass(frozen=True)
 class RotorParams:
-    """Rotor and bearing parameters, SI units (MODEL.md §1 and §3).
+    """Rotor and bearing parameters, SI units (MODEL.md §1 and §3), within the model's
+    mathematical domain below. The FMU accepts the narrower physical ranges of
+    ``limits.LIMITS``, all inside this domain (tests/test_limits.py checks it).
 
     m    rotor mass, kg (> 0)
     c    AMB damping, N s/m (>= 0)

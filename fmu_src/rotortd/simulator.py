@@ -52,6 +52,7 @@ from .contact import (
 from .events import ContactLocator, Work, flight_is_clear
 from .flight import FlightModel
 from .impact import Impact, reset
+from .limits import CrossParameterError, start_position
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
 
 MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
@@ -201,11 +202,7 @@ class TouchdownCore:
             ("t0", t0),
         ):
             check_finite(name, val)
-        if abs(z0) > params.c_r * (1.0 + 1e-12):
-            raise ParameterError(
-                f"initial position |z0| = {abs(z0)!r} m is outside the clearance: "
-                f"it must satisfy sqrt(x0^2 + y0^2) <= c_r = {params.c_r!r} m"
-            )
+        z0 = start_position(z0, params.c_r)
         self._p = params
         self._t = float(t0)
         self._t_lo = 0.0  # compensation of the clock (Kahan), s
@@ -278,14 +275,14 @@ class TouchdownCore:
         )
         den = complex(fm.kappa - fm.Omega**2, fm.beta * fm.Omega)
         if fm.kappa <= 0.0 or den == 0:
-            raise ParameterError(
+            raise CrossParameterError(
                 "start_steady: no steady whirl exists without stiffness (k*amb_on > 0) "
                 "or at undamped resonance (c = 0 and Omega^2 = k/m)"
             )
         E0 = cmath.exp(1j * psi0)
         Z0, Z1 = fm.f0 / fm.kappa, fm.F1 * E0 / den
         if abs(Z0) + abs(Z1) >= params.c_r:
-            raise ParameterError(
+            raise CrossParameterError(
                 f"start_steady: the steady whirl is not admissible, its radius reaches "
                 f"|Z0| + |Z1| = {(abs(Z0) + abs(Z1)) / params.c_r:.6g} c_r; it must be < 1 c_r"
             )

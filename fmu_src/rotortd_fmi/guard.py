@@ -4,9 +4,16 @@ No exception may escape into PythonFMU's C wrapper (its fatal path). An adapter 
 ``GuardedSlave`` and implements ``_initialise()`` and ``_step(t, h) -> bool``; a failure is
 logged with ``Fmi2Status.error``, the call returns False (fmi2Discard), and every later
 ``do_step`` is refused with the first failure's message. Standard library and pythonfmu only.
+
+PythonFMU 0.7.0 forwards log messages only when the host turned logging on, so a failure
+also writes one line to stderr (``<instance>: error: <message>``): a user of ``fmpy
+simulate`` sees why the run stopped without extra flags. ``do_step`` after ``terminate``
+is refused (FMI allows only fmi2FreeInstance or fmi2Reset then).
 """
 
 from __future__ import annotations
+
+import sys
 
 from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
@@ -16,6 +23,10 @@ class GuardedSlave(Fmi2Slave):
     """Fmi2Slave whose initialisation and steps report errors instead of raising them."""
 
     _failure = ""  # non-empty: the model is unusable and do_step refuses
+    _terminated = False  # fmi2Terminate was called: do_step refuses
+
+    def terminate(self) -> None:
+        self._terminated = True
 
     def exit_initialization_mode(self) -> bool:
         try:
@@ -26,6 +37,10 @@ class GuardedSlave(Fmi2Slave):
             return False
 
     def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._terminated:
+            self.log(f"do_step at t={current_time!r} refused: called after fmi2Terminate",
+                     Fmi2Status.error)
+            return False
         if self._failure:
             self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
             return False
@@ -36,8 +51,20 @@ class GuardedSlave(Fmi2Slave):
             return False
 
     def _fail(self, msg: str) -> None:
+        first = not self._failure
         self._failure = msg
         self.log(msg, Fmi2Status.error)
+        if first:
+            _stderr_line(f"{self.instance_name}: error: {msg}")
+
+
+def _stderr_line(line: str) -> None:
+    """One line on stderr, best effort (a host may have closed it)."""
+    try:
+        sys.stderr.write(" ".join(line.split()) + "\n")
+        sys.stderr.flush()
+    except Exception:
+        pass
 
     def _initialise(self) -> None:
         """Build the model from the parameters (exitInitializationMode); raise on error."""

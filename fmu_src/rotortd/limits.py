@@ -1,0 +1,121 @@
+"""The admissible range of every parameter, initial value and input: one table, SI units.
+
+This is the single source of the ranges. The core enforces them (``RotorParams``, the
+initial state of ``TouchdownCore``, the inputs of a step); the FMU's variable table
+(``rotortd_fmi.variables``) declares the same numbers as ``min``/``max`` in its model
+description. Every bound is finite and inclusive (FMI min/max are inclusive), chosen so that
+every real machine lies inside and everything inside can be simulated without overflow:
+docs/fmu.md ("Ranges") says why each bound is where it is.
+
+A value outside its range is reported as ``name = value unit is out of range: it must lie
+in [lo, hi] unit``; ``violations`` lists every such value at once. Constraints that tie
+several values together (a start inside the clearance, an admissible steady whirl) raise
+``CrossParameterError``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+
+class ParameterError(ValueError):
+    """A parameter or initial state is invalid; the message names it and its allowed range."""
+
+
+class CrossParameterError(ParameterError):
+    """Values each inside their range that violate a constraint tying them together."""
+
+
+class InputError(ValueError):
+    """An input held over a step (or the step length) is invalid; the message names it."""
+
+
+@dataclass(frozen=True)
+class Limit:
+    """Closed range ``[lo, hi]`` of one quantity, in ``unit`` (FMI unit name)."""
+
+    unit: str
+    lo: float
+    hi: float
+
+    def message(self, name: str, value: float) -> str | None:
+        """None when ``value`` lies in the range, else the message naming it."""
+        x = float(value)
+        if self.lo <= x <= self.hi:  # False for NaN
+            return None
+        u = f" {self.unit}" if self.unit and self.unit != "1" else ""
+        what = "is not finite" if not math.isfinite(x) else "is out of range"
+        return f"{name} = {x!r}{u} {what}: it must lie in [{self.lo:g}, {self.hi:g}]{u}"
+
+
+ANGLE = Limit("rad", -1e4, 1e4)
+"""Angles: any phase, kept to |angle| <= 1e4 rad so that wrapping loses < 2e-12 rad."""
+
+LIMITS: dict[str, Limit] = {
+    # rotor and bearing (RotorParams)
+    "m": Limit("kg", 1e-3, 1e6),
+    "c": Limit("N.s/m", 0.0, 1e8),
+    "k": Limit("N/m", 0.0, 1e10),
+    "e_c": Limit("m", 0.0, 0.1),
+    "phi": ANGLE,
+    "c_r": Limit("m", 1e-6, 0.1),
+    "R": Limit("m", 1e-3, 10.0),
+    "mu": Limit("1", 0.0, 10.0),
+    "d": Limit("1", 0.0, 1.0),
+    "g": Limit("m/s2", 0.0, 1e3),
+    # initial state
+    "x0": Limit("m", -0.1, 0.1),
+    "y0": Limit("m", -0.1, 0.1),
+    "vx0": Limit("m/s", -1e4, 1e4),
+    "vy0": Limit("m/s", -1e4, 1e4),
+    "psi0": ANGLE,
+    # spin (rotortd_drive)
+    "J": Limit("kg.m2", 1e-9, 1e7),
+    "h_spin": Limit("s", 1e-8, 1.0),
+    # inputs held over a step
+    "Omega": Limit("rad/s", -1e5, 1e5),
+    "F_x": Limit("N", -1e12, 1e12),
+    "F_y": Limit("N", -1e12, 1e12),
+    "amb_on": Limit("1", 0.0, 1.0),
+    "T_drive": Limit("N.m", -1e9, 1e9),
+}
+
+START_ULPS = 4
+"""A start position at most this many ulp of c_r outside the clearance is projected onto it."""
+
+
+def violations(values: Mapping[str, float] | Iterable[tuple[str, float]]) -> list[str]:
+    """The message of every value outside its range (names not in LIMITS are skipped)."""
+    items = values.items() if isinstance(values, Mapping) else values
+    found = []
+    for name, value in items:
+        limit = LIMITS.get(name)
+        msg = None if limit is None else limit.message(name, value)
+        if msg is not None:
+            found.append(msg)
+    return found
+
+
+def require(values: Mapping[str, float] | Iterable[tuple[str, float]],
+            error: type[ValueError] = ParameterError) -> None:
+    """Raise ``error`` listing every value outside its range ("; "-separated)."""
+    found = violations(values)
+    if found:
+        raise error("; ".join(found))
+
+
+def start_position(z0: complex, c_r: float) -> complex:
+    """The initial position (m, inertial), projected onto the clearance circle when it lies
+    within START_ULPS ulp of c_r outside it (a point c_r e^{ia} rounds so); farther out it
+    raises CrossParameterError."""
+    r = abs(z0)
+    if r <= c_r:
+        return z0
+    if r <= c_r + START_ULPS * math.ulp(c_r):
+        return z0 * (c_r / r)
+    raise CrossParameterError(
+        f"initial position |z0| = |(x0, y0)| = {r!r} m is outside the clearance: "
+        f"it must satisfy sqrt(x0^2 + y0^2) <= c_r = {c_r!r} m"
+    )

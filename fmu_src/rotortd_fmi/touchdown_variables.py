@@ -1,0 +1,102 @@
+"""The variable table of the FMU RotorTouchdown (see ``variables``): the single source of its
+names, causalities, types, starts, units, ranges, descriptions and tunable set.
+
+The order of the rows is the order of registration, hence of the value references.
+"""
+
+from __future__ import annotations
+
+from .variables import INPUT, OUTPUT, PARAMETER, Var, fixed, limited, names, output
+
+TABLE: tuple[Var, ...] = (
+    # parameters of the rotor and bearing (rotortd.RotorParams)
+    limited("m", PARAMETER, 50.0, "Rotor mass"),
+    limited("c", PARAMETER, 1400.0, "AMB damping (PD controller); tunable", tunable=True),
+    limited("k", PARAMETER, 9.8e5, "AMB stiffness (PD controller); tunable", tunable=True),
+    limited("e_c", PARAMETER, 0.3e-3, "Imbalance eccentricity; tunable", tunable=True),
+    limited("phi", PARAMETER, 0.21, "Imbalance phase; tunable", tunable=True),
+    limited("c_r", PARAMETER, 0.7e-3, "Radial clearance of the touchdown bearing"),
+    limited("R", PARAMETER, 0.04, "Rotor radius at the touchdown bearing"),
+    limited("mu", PARAMETER, 0.15, "Coulomb friction coefficient rotor/TDB; tunable",
+            tunable=True),
+    limited("d", PARAMETER, 0.95, "Newton coefficient of restitution; tunable", tunable=True),
+    limited("g", PARAMETER, 0.0, "Gravity acting in -y (9.81 for a horizontal rotor)"),
+    # initial state
+    limited("x0", PARAMETER, 0.0, "Initial position x, |(x0, y0)| <= c_r; ignored if "
+                                  "start_steady"),
+    limited("y0", PARAMETER, 0.0, "Initial position y, |(x0, y0)| <= c_r; ignored if "
+                                  "start_steady"),
+    limited("vx0", PARAMETER, 0.0, "Initial velocity x; ignored if start_steady"),
+    limited("vy0", PARAMETER, 0.0, "Initial velocity y; ignored if start_steady"),
+    limited("psi0", PARAMETER, 0.0, "Initial spin angle"),
+    # spin
+    limited("J", PARAMETER, 0.04, "Polar inertia of the spin, used if integrate_spin"),
+    limited("h_spin", PARAMETER, 1e-6, "Largest internal sub-step of the spin integration, "
+                                       "used if integrate_spin"),
+    fixed("levitate", "Boolean", True,
+          "AMB bias force +i m g holds the rotor centred against gravity"),
+    fixed("start_steady", "Boolean", False,
+          "Start on the steady free whirl (error if not admissible); overrides x0, y0, vx0, "
+          "vy0"),
+    fixed("integrate_spin", "Boolean", False,
+          "Integrate the spin inside the FMU: J Omega' = T_drive + T_f, sub-stepped at "
+          "h_spin; the input Omega is then only the initial speed and Omega_out the spin"),
+    fixed("impact_log", "String", "",
+          "If not empty: CSV path; every impact is appended (time, x, y, vx-, vy-, vx+, vy+, "
+          "rdot, P_n, P_t, stick)"),
+    # inputs, held over a step
+    limited("Omega", INPUT, 184.2, "Spin speed, held over the step"),
+    limited("F_x", INPUT, 0.0, "External force on the rotor, x"),
+    limited("F_y", INPUT, 0.0, "External force on the rotor, y"),
+    limited("amb_on", INPUT, 1.0, "Magnetic bearing state: 1 on, 0 failed"),
+    limited("T_drive", INPUT, 0.0, "Drive torque on the spin (motor minus drag), used if "
+                                   "integrate_spin"),
+    # outputs
+    output("x", "m", "Rotor centre position x, inertial, |(x, y)| <= c_r"),
+    output("y", "m", "Rotor centre position y, inertial, |(x, y)| <= c_r"),
+    output("vx", "m/s", "Rotor centre velocity x, inertial"),
+    output("vy", "m/s", "Rotor centre velocity y, inertial"),
+    output("r_rel", "1", "Radial position relative to clearance r/c_r", 0.0),
+    output("u_re", "1", "Co-rotating scaled position Re U, U = z exp(-i psi)/c_r, |U| <= 1"),
+    output("u_im", "1", "Co-rotating scaled position Im U, |U| <= 1"),
+    output("du_re", "1", "Co-rotating scaled velocity Re dU/dt, t = Omega tau; 0 when "
+                         "Omega = 0"),
+    output("du_im", "1", "Co-rotating scaled velocity Im dU/dt, t = Omega tau; 0 when "
+                         "Omega = 0"),
+    output("psi", "rad", "Spin angle wrapped to (-pi, pi]"),
+    output("whirl_rate", "rad/s", "Inertial whirl rate theta' (rate of the polar angle of z)"),
+    output("v_rel", "m/s", "Slip velocity at the contact point R Omega + c_r theta'"),
+    output("F_bx", "N", "Bearing (contact) force on the rotor x, step-averaged, impulses as "
+                        "P/h"),
+    output("F_by", "N", "Bearing (contact) force on the rotor y, step-averaged, impulses as "
+                        "P/h"),
+    output("F_n", "N", "Normal contact force, step-averaged", 0.0),
+    output("F_n_peak", "N", "Peak normal contact force within the step", 0.0),
+    output("P_n", "N.s", "Normal contact impulse within the step", 0.0),
+    output("T_f", "N.m", "Friction torque on the spin, step-averaged; < 0 brakes a positive "
+                         "spin"),
+    output("F_amb_x", "N", "Magnetic bearing force x at the end of the step"),
+    output("F_amb_y", "N", "Magnetic bearing force y at the end of the step"),
+    output("t_last_impact", "s", "Time of the last impact; 0 before any impact"),
+    output("v_last_impact", "m/s", "Normal speed rdot- of the last impact; 0 before any", 0.0),
+    output("E_diss", "J", "Energy dissipated by contact, cumulative", 0.0),
+    output("Omega_out", "rad/s", "Spin speed at the end of the step: the integrated spin if "
+                                 "integrate_spin, else the input Omega"),
+    output("mode", "", "Contact mode at the end of the step: 0 free, 1 sliding, 2 rolling",
+           0, 2, "Integer"),
+    output("n_impacts", "", "Number of impacts since the start, cumulative", 0, None,
+           "Integer"),
+    output("n_impacts_step", "", "Number of impacts within the last step", 0, None,
+           "Integer"),
+    output("in_contact", "", "Rotor in sustained contact (mode != 0) at the end of the step",
+           type_="Boolean"),
+)
+
+PARAMETERS = names(TABLE, PARAMETER)
+TUNABLE: frozenset[str] = frozenset(names(TABLE, PARAMETER, tunable=True))
+FIXED = names(TABLE, PARAMETER, tunable=False)
+INPUTS = names(TABLE, INPUT)
+OUTPUTS = names(TABLE, OUTPUT)
+RANGED_PARAMETERS = tuple(v.name for v in TABLE
+                          if v.causality == PARAMETER and v.type == "Real")
+"""Real parameters: each has a closed range (rotortd.limits) checked at initialisation."""

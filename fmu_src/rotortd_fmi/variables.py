@@ -1,0 +1,102 @@
+"""One variable table per FMU: the single source of its FMI variables.
+
+Each row (``Var``) gives name, causality, type, start, unit, min, max, description and
+whether a parameter is tunable. Everything else derives from the table: the PythonFMU
+registration (``register``), the unit/min/max that build.py writes into
+modelDescription.xml (``meta``), the fixed and tunable sets, the validation ranges (rows of
+quantities the core knows take unit, min and max from ``rotortd.limits.LIMITS``, so what the
+FMU declares is what the core enforces), and, through the built model description, the SSP
+types. Standard library and pythonfmu only; the table is plain data, built once per process.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from pythonfmu import Boolean, Integer, Real, String
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
+
+PARAMETER, INPUT, OUTPUT = "parameter", "input", "output"
+_TYPES = {"Real": Real, "Integer": Integer, "Boolean": Boolean, "String": String}
+
+
+@dataclass(frozen=True)
+class Var:
+    """One FMI variable. ``lo``/``hi`` are the inclusive min/max (None: unbounded)."""
+
+    name: str
+    causality: str
+    type: str
+    start: Any
+    unit: str
+    lo: float | None
+    hi: float | None
+    description: str
+    tunable: bool = False
+
+    @property
+    def fmi_description(self) -> str:
+        """The description with the unit and the range, both derived from the row."""
+        unit = f" [{self.unit or '-'}]"
+        if self.lo is None and self.hi is None:
+            return f"{self.description}{unit}"
+        lo = "-inf" if self.lo is None else f"{self.lo:g}"
+        hi = "inf" if self.hi is None else f"{self.hi:g}"
+        return f"{self.description}{unit}, in [{lo}, {hi}]"
+
+
+def limited(name: str, causality: str, start: float, description: str, *,
+            tunable: bool = False) -> Var:
+    """A Real parameter or input whose unit and range are those the core enforces."""
+    from rotortd.limits import LIMITS  # resources/rotortd inside the FMU
+
+    lim = LIMITS[name]
+    return Var(name, causality, "Real", start, lim.unit, lim.lo, lim.hi, description, tunable)
+
+
+def fixed(name: str, type_: str, start: Any, description: str) -> Var:
+    """A fixed parameter without a range (Boolean, String)."""
+    return Var(name, PARAMETER, type_, start, "", None, None, description)
+
+
+def output(name: str, unit: str, description: str, lo: float | None = None,
+           hi: float | None = None, type_: str = "Real") -> Var:
+    """An output computed in doStep (initial exact)."""
+    start = {"Real": 0.0, "Integer": 0, "Boolean": False}[type_]
+    return Var(name, OUTPUT, type_, start, unit, lo, hi, description)
+
+
+def names(table: Iterable[Var], causality: str, *, tunable: bool | None = None) -> tuple:
+    """Names of the rows of one causality (parameters: only tunable or fixed ones if asked)."""
+    return tuple(v.name for v in table if v.causality == causality
+                 and (tunable is None or v.tunable == tunable))
+
+
+def meta(table: Iterable[Var]) -> dict[str, tuple[str, float | None, float | None]]:
+    """{name: (unit, min, max)} of the Real and Integer rows, for build.py."""
+    return {v.name: (v.unit, v.lo, v.hi) for v in table if v.type in ("Real", "Integer")}
+
+
+def register(slave: Any, table: Iterable[Var], watched: Callable[[str], Any],
+             refused: Callable[[str], Any]) -> None:
+    """Set each start value on ``slave`` and register the variable with PythonFMU.
+
+    ``watched(name)`` gives the setter of a parameter or input, ``refused(name)`` that of
+    an output (a host may not set it)."""
+    for v in table:
+        setattr(slave, v.name, v.start)
+        kwargs: dict[str, Any] = {"causality": getattr(Fmi2Causality, v.causality),
+                                  "description": v.fmi_description}
+        if v.causality == OUTPUT:
+            kwargs["initial"] = Fmi2Initial.exact
+            kwargs["setter"] = refused(v.name)
+            if v.type != "Real":
+                kwargs["variability"] = Fmi2Variability.discrete
+        else:
+            kwargs["setter"] = watched(v.name)
+            if v.causality == PARAMETER:
+                kwargs["variability"] = (Fmi2Variability.tunable if v.tunable
+                                         else Fmi2Variability.fixed)
+        slave.register_variable(_TYPES[v.type](v.name, **kwargs))
