@@ -324,6 +324,28 @@ def sc_bad_state(fmu: str, blob: str) -> dict[str, Any]:
     return {"status": inst.step(1e-4), "messages": [m["message"] for m in MESSAGES]}
 
 
+def sc_ranges(fmu: str, cases: dict[str, list[float]]) -> dict[str, Any]:
+    """For each variable: statuses of init + one step with a value inside its range, and
+    the error messages with a value outside (a parameter at init, an input mid-run)."""
+    results = {}
+    unzipdir = extract(fmu)
+    for name, (inside, outside) in cases.items():
+        inst = Instance(fmu, unzipdir=unzipdir)
+        is_input = next(v.causality for v in inst.md.modelVariables if v.name == name) == "input"
+        MESSAGES.clear()
+        inst.init({name: inside})
+        ok = [max((m["status"] for m in MESSAGES), default=0), inst.step(1e-4)]
+        bad = Instance(fmu, unzipdir=unzipdir)
+        MESSAGES.clear()
+        bad.init({} if is_input else {name: outside})
+        if is_input:
+            bad.step(1e-4)
+            bad.set({name: outside})
+        bad.step(1e-4)
+        results[name] = (ok, [m["message"] for m in MESSAGES if m["status"] >= 3])
+    return {"results": results}
+
+
 SCENARIOS: dict[str, Callable[..., dict[str, Any]]] = {
     name[3:]: fn for name, fn in globals().items() if name.startswith("sc_")
 }

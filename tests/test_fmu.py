@@ -7,7 +7,6 @@ import csv
 import io
 import json
 import math
-import os
 import subprocess
 import sys
 import zipfile
@@ -22,20 +21,6 @@ ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = Path(__file__).resolve().parent / "fmu_scenarios.py"
 C_R = 0.7e-3
 OMEGA = 184.2
-
-
-@pytest.fixture(scope="session")
-def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Build the FMU once per session with build.py's own function (no validation here:
-    test_fmu_validates does that). ROTORTD_FMU=path skips the build and tests that FMU."""
-    prebuilt = os.environ.get("ROTORTD_FMU")
-    if prebuilt:
-        return Path(prebuilt).resolve()
-    sys.path.insert(0, str(ROOT))
-    import build
-
-    spec = next(s for s in build.FMU_SPECS if s.name == "RotorTouchdown")
-    return build.build_fmu(spec, tmp_path_factory.mktemp("fmu"))
 
 
 def run_scenario(fmu: Path, name: str, timeout: float = 120.0, **kwargs: Any) -> dict:

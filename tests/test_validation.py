@@ -12,8 +12,6 @@ scene x h in {1e-5, 1e-4, 1e-3, 1e-2} s x {api, cli} (88 runs, measured 96 s).
 
 from __future__ import annotations
 
-import os
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,19 +21,6 @@ from tests import validation_lib as V
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = V.scene_names()
-
-
-@pytest.fixture(scope="session")
-def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The FMU built from the current sources (ROTORTD_FMU=path tests a given FMU)."""
-    prebuilt = os.environ.get("ROTORTD_FMU")
-    if prebuilt:
-        return Path(prebuilt).resolve()
-    sys.path.insert(0, str(ROOT))
-    import build
-
-    spec = next(s for s in build.FMU_SPECS if s.name == "RotorTouchdown")
-    return build.build_fmu(spec, tmp_path_factory.mktemp("fmu_validation"))
 
 
 def _assert_agrees(fmu: Path, scene: str, h: float, api: str, workdir: Path) -> None:

@@ -391,9 +391,15 @@ class RotorTouchdownFloor(_adapter.RotorTouchdownFloorAdapter):
 
 def _adapter_tables() -> dict[str, Any]:
     from rotortd_fmi import touchdown as mod
+    from rotortd_fmi.touchdown_variables import TABLE
 
-    return {"meta": mod.VARIABLE_META, "params": mod.REAL_PARAMETERS,
-            "tunable": set(mod.TUNABLE), "inputs": mod.INPUTS, "outputs": mod.REAL_OUTPUTS}
+    def rows(causality: str) -> tuple:
+        return tuple((v.name, v.start, v.description) for v in TABLE
+                     if v.causality == causality and v.type == "Real")
+
+    return {"meta": mod.VARIABLE_META, "params": rows("parameter"),
+            "tunable": set(mod.TUNABLE), "inputs": rows("input"),
+            "outputs": tuple((n, d) for n, _s, d in rows("output"))}
 
 
 def build_fmus(tmp: Path) -> dict[str, tuple[str, Any]]:

@@ -25,6 +25,7 @@ import copy
 import json
 import math
 import operator
+from dataclasses import fields
 from typing import Any
 
 from pythonfmu import DefaultExperiment
@@ -39,7 +40,6 @@ STATE_VERSION = 1
 
 VARIABLE_META = meta(tv.TABLE)  # read by build.py
 TUNABLE, FIXED, INPUTS = tv.TUNABLE, tv.FIXED, tv.INPUTS
-CORE_PARAMS: tuple[str, ...] = ("m", "c", "k", "e_c", "phi", "c_r", "R", "mu", "d", "g")
 
 _get_fixed = operator.attrgetter(*FIXED)
 _get_tunables = operator.attrgetter(*sorted(TUNABLE))
@@ -185,7 +185,8 @@ class RotorTouchdownAdapter(GuardedSlave):
         return SpinCoupler(float(self.J), float(self.h_spin), omega)
 
     def _make_params(self, rotortd: Any) -> Any:
-        kwargs = {name: float(getattr(self, name)) for name in CORE_PARAMS}
+        kwargs = {f.name: float(getattr(self, f.name)) for f in fields(rotortd.RotorParams)
+                  if f.name != "levitate"}
         return rotortd.RotorParams(levitate=bool(self.levitate), **kwargs)
 
     def _fixed_values(self) -> dict[str, Any]:
