@@ -25,17 +25,27 @@ from .scenes import CONNECTIONS, FMU_FILES, RECORDED, SCENES, Scene
 NS = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
       'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
       'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"')
-INTEGER_VARS = frozenset({"mode", "n_impacts", "n_impacts_step", "motor", "pi_regime"})
-BOOLEAN_VARS = frozenset({"levitate", "start_steady", "integrate_spin", "follow_speed",
-                          "in_contact"})
+Types = dict[str, dict[str, str]]
+"""Component name -> {variable name: FMI type}, read from the built FMUs."""
 
 
-def ssv_type(name: str, value: Any) -> tuple[str, str]:
-    """SSV element name and value text for a start value."""
-    if name in BOOLEAN_VARS:
+def variable_types(models: Path) -> Types:
+    """The type of every variable of each component, from its FMU's model description
+    (the FMU's variable table is the one source of its types)."""
+    from fmpy import read_model_description
+
+    return {comp: {v.name: v.type for v in read_model_description(str(models / fmu))
+                   .modelVariables} for comp, fmu in FMU_FILES.items()}
+
+
+def ssv_type(fmi_type: str, value: Any) -> tuple[str, str]:
+    """SSV element name and value text of a start value of the given FMI type."""
+    if fmi_type == "Boolean":
         return "Boolean", "true" if value else "false"
-    if name in INTEGER_VARS:
+    if fmi_type == "Integer":
         return "Integer", str(int(value))
+    if fmi_type == "String":
+        return "String", str(value)
     return "Real", repr(float(value))
 
 
@@ -53,13 +63,15 @@ def connectors(component: str) -> list[tuple[str, str]]:
     return list(found.items())
 
 
-def _component_xml(name: str, values: dict[str, Any], scene: str) -> str:
+def _component_xml(name: str, values: dict[str, Any], scene: str, types: dict[str, str]
+                   ) -> str:
     conns = "\n".join(
-        f'          <ssd:Connector name="{c}" kind="{k}"><ssc:{ssv_type(c, 0)[0]}/>'
+        f'          <ssd:Connector name="{c}" kind="{k}"><ssc:{types[c]}/>'
         f"</ssd:Connector>" for c, k in connectors(name))
     params = "\n".join(
         f'                <ssv:Parameter name="{p}"><ssv:{t} value={quoteattr(v)}/>'
-        f"</ssv:Parameter>" for p, (t, v) in ((p, ssv_type(p, x)) for p, x in values.items()))
+        f"</ssv:Parameter>" for p, (t, v) in ((p, ssv_type(types[p], x))
+                                              for p, x in values.items()))
     binding = ""
     if values:
         binding = f"""
@@ -82,9 +94,10 @@ source="resources/{FMU_FILES[name]}">
       </ssd:Component>"""
 
 
-def ssd_text(scene: Scene) -> str:
+def ssd_text(scene: Scene, types: Types) -> str:
     """SystemStructure.ssd of a scene."""
-    comps = "\n".join(_component_xml(n, v, scene.name) for n, v in scene.components().items())
+    comps = "\n".join(_component_xml(n, v, scene.name, types[n])
+                      for n, v in scene.components().items())
     conns = "\n".join(
         f'      <ssd:Connection startElement="{a}" startConnector="{o}" endElement="{b}" '
         f'endConnector="{i}"/>' for a, o, b, i in CONNECTIONS)
@@ -106,7 +119,7 @@ def ssd_text(scene: Scene) -> str:
 def write_ssp(scene: Scene, models: Path, out_dir: Path) -> Path:
     """Write <out_dir>/<scene>.ssp (FMUs taken from models/) and <out_dir>/<scene>.ssd."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    text = ssd_text(scene)
+    text = ssd_text(scene, variable_types(models))
     (out_dir / f"{scene.name}.ssd").write_text(text, encoding="utf-8")
     path = out_dir / f"{scene.name}.ssp"
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
