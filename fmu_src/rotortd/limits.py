@@ -7,16 +7,15 @@ description. Every bound is finite and inclusive (FMI min/max are inclusive), ch
 every real machine lies inside and everything inside can be simulated without overflow:
 docs/fmu.md ("Ranges") says why each bound is where it is.
 
-A value outside its range is reported as ``name = value unit is out of range: it must lie
-in [lo, hi] unit``; ``violations`` lists every such value at once. Constraints that tie
-several values together (a start inside the clearance, an admissible steady whirl) raise
-``CrossParameterError``.
+The core's own domain checks (``RotorParams``: ``m > 0``, ...) are wider, for scale-free
+studies; the FMU checks these ranges (``rotortd_fmi.variables.range_violations``) and
+reports every value outside at once. Constraints that tie several values together (a start
+inside the clearance, an admissible steady whirl) raise ``CrossParameterError``.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 
@@ -39,15 +38,6 @@ class Limit:
     unit: str
     lo: float
     hi: float
-
-    def message(self, name: str, value: float) -> str | None:
-        """None when ``value`` lies in the range, else the message naming it."""
-        x = float(value)
-        if self.lo <= x <= self.hi:  # False for NaN
-            return None
-        u = f" {self.unit}" if self.unit and self.unit != "1" else ""
-        what = "is not finite" if not math.isfinite(x) else "is out of range"
-        return f"{name} = {x!r}{u} {what}: it must lie in [{self.lo:g}, {self.hi:g}]{u}"
 
 
 ANGLE = Limit("rad", -1e4, 1e4)
@@ -84,26 +74,6 @@ LIMITS: dict[str, Limit] = {
 
 START_ULPS = 4
 """A start position at most this many ulp of c_r outside the clearance is projected onto it."""
-
-
-def violations(values: Mapping[str, float] | Iterable[tuple[str, float]]) -> list[str]:
-    """The message of every value outside its range (names not in LIMITS are skipped)."""
-    items = values.items() if isinstance(values, Mapping) else values
-    found = []
-    for name, value in items:
-        limit = LIMITS.get(name)
-        msg = None if limit is None else limit.message(name, value)
-        if msg is not None:
-            found.append(msg)
-    return found
-
-
-def require(values: Mapping[str, float] | Iterable[tuple[str, float]],
-            error: type[ValueError] = ParameterError) -> None:
-    """Raise ``error`` listing every value outside its range ("; "-separated)."""
-    found = violations(values)
-    if found:
-        raise error("; ".join(found))
 
 
 def start_position(z0: complex, c_r: float) -> complex:

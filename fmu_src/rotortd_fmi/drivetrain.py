@@ -24,67 +24,16 @@ import json
 import math
 from typing import Any
 
-from pythonfmu import Boolean, DefaultExperiment, Integer, Real
-from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
+from pythonfmu import DefaultExperiment
 
+from . import drivetrain_variables as dv
 from .guard import GuardedSlave
+from .variables import meta, register
 
 STATE_SCHEMA = "rotortd-drivetrain-fmu-state"
 
-VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
-    "J": ("kg.m2", 0.0, None),
-    "b": ("N.m.s", 0.0, None),
-    "Kp": ("N.m.s", 0.0, None),
-    "Ki": ("N.m", 0.0, None),
-    "T_max": ("N.m", 0.0, None),
-    "Omega0": ("rad/s", None, None),
-    "psi0": ("rad", None, None),
-    "T_bearing": ("N.m", None, None),
-    "T_motor_in": ("N.m", None, None),
-    "Omega_set": ("rad/s", None, None),
-    "Omega_in": ("rad/s", None, None),
-    "Omega": ("rad/s", None, None),
-    "psi": ("rad", None, None),
-    "T_motor": ("N.m", None, None),
-    "T_drag": ("N.m", None, None),
-    "T_drive": ("N.m", None, None),
-    "pi_integral": ("rad", None, None),
-    "H_motor": ("N.m.s", None, None),
-    "H_drag": ("N.m.s", None, None),
-    "H_bearing": ("N.m.s", None, None),
-    "motor": ("", 0, 1),
-    "pi_regime": ("", 0, 2),
-}
-
-FIXED = ("J", "Omega0", "psi0")
-TUNABLE = ("b", "Kp", "Ki", "T_max")
-PARAMETERS: tuple[tuple[str, float, str], ...] = (
-    ("J", 0.04, "Polar inertia of rotor and drive [kg.m2], > 0"),
-    ("Omega0", 184.2, "Initial spin speed [rad/s], finite"),
-    ("psi0", 0.0, "Initial spin angle [rad], finite"),
-    ("b", 1e-4, "Viscous drag coefficient [N.m.s], >= 0; tunable"),
-    ("Kp", 0.2, "PI proportional gain [N.m.s], >= 0; tunable"),
-    ("Ki", 2.0, "PI integral gain [N.m], >= 0; tunable"),
-    ("T_max", 5.0, "PI torque limit |T_motor| <= T_max [N.m], > 0; tunable"),
-)
-INPUTS: tuple[tuple[str, float, str], ...] = (
-    ("T_bearing", 0.0, "Torque from the bearing (RotorTouchdown.T_f), held over the step "
-                       "[N.m]"),
-    ("T_motor_in", 0.0, "Motor torque if motor = 0 (torque input), held [N.m]"),
-    ("Omega_set", 184.2, "Speed set-point of the PI controller (motor = 1) [rad/s]"),
-    ("Omega_in", 0.0, "Spin speed imposed from outside if follow_speed [rad/s]"),
-)
-OUTPUTS: tuple[tuple[str, str], ...] = (
-    ("Omega", "Spin speed at the end of the step [rad/s]"),
-    ("psi", "Spin angle wrapped to (-pi, pi] [rad]"),
-    ("T_motor", "Motor torque averaged over the step [N.m]"),
-    ("T_drag", "Drag torque -b Omega averaged over the step [N.m]"),
-    ("T_drive", "T_motor + T_drag averaged over the step (to RotorTouchdown.T_drive) [N.m]"),
-    ("pi_integral", "PI integrator state, integral of Omega_set - Omega [rad]"),
-    ("H_motor", "Angular impulse of the motor since the start, cumulative [N.m.s]"),
-    ("H_drag", "Angular impulse of the drag since the start, cumulative [N.m.s]"),
-    ("H_bearing", "Angular impulse of T_bearing since the start, cumulative [N.m.s]"),
-)
+VARIABLE_META = meta(dv.TABLE)  # read by build.py
+TUNABLE, FIXED = dv.TUNABLE, dv.FIXED
 
 
 def _wrap(angle: float) -> float:
@@ -112,36 +61,14 @@ class DrivetrainAdapter(GuardedSlave):
 
     # ------------------------------------------------------------------ declaration
     def _declare(self) -> None:
-        for name, start, desc in PARAMETERS:
-            setattr(self, name, start)
-            var = Fmi2Variability.tunable if name in TUNABLE else Fmi2Variability.fixed
-            self.register_variable(Real(name, causality=Fmi2Causality.parameter,
-                                        variability=var, description=desc))
-        self.motor = 0
-        self.register_variable(Integer(
-            "motor", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-            description="Motor model: 0 torque input T_motor_in, 1 PI speed controller [-]"))
-        self.follow_speed = False
-        self.register_variable(Boolean(
-            "follow_speed", causality=Fmi2Causality.parameter,
-            variability=Fmi2Variability.fixed,
-            description="Omega follows the input Omega_in (the spin is integrated "
-                        "elsewhere, e.g. RotorTouchdown with integrate_spin) [-]"))
-        for name, start, desc in INPUTS:
-            setattr(self, name, start)
-            self.register_variable(Real(name, causality=Fmi2Causality.input, description=desc))
-        for name, desc in OUTPUTS:
-            setattr(self, name, 0.0)
-            getter = self._omega_getter if name == "Omega" else None
-            self.register_variable(Real(name, causality=Fmi2Causality.output,
-                                        initial=Fmi2Initial.exact, description=desc,
-                                        getter=getter))
-        self.pi_regime = 0
-        self.register_variable(Integer(
-            "pi_regime", causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
-            initial=Fmi2Initial.exact,
-            description="PI regime at the end of the step: 0 linear, 1 saturated, 2 on the "
-                        "limit with the integrator following it [-]"))
+        register(self, dv.TABLE, lambda _name: None, self._output_setter,
+                 getters={"Omega": self._omega_getter})
+
+    def _output_setter(self, name: str) -> Any:
+        def refuse(value: Any) -> None:
+            self._fail(f"output '{name}' cannot be set by the host (the value {value!r} "
+                       f"was ignored)")
+        return refuse
 
     def _omega_getter(self) -> float:
         """Omega: the state once initialised, before that the start value (hosts that
@@ -161,12 +88,12 @@ class DrivetrainAdapter(GuardedSlave):
     def _initialise(self) -> None:
         from rotortd_drive import DriveCore
 
-        for name, _s, _d in PARAMETERS + INPUTS:
+        for name in dv.REAL_PARAMETERS + dv.INPUTS:
             if not math.isfinite(float(getattr(self, name))):
                 raise ValueError(f"{name}={getattr(self, name)!r} is not finite")
         omega0 = float(self.Omega_in) if self.follow_speed else float(self.Omega0)
         self._core = DriveCore(self._params(), omega0, psi0=float(self.psi0))
-        self._fixed = {n: getattr(self, n) for n in (*FIXED, "motor", "follow_speed")}
+        self._fixed = {n: getattr(self, n) for n in FIXED}
         self._publish(None)
 
     def _step(self, current_time: float, step_size: float) -> bool:

@@ -19,38 +19,32 @@ from __future__ import annotations
 
 from typing import Any
 
-from pythonfmu import DefaultExperiment, Fmi2Slave, Real
-from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+from pythonfmu import DefaultExperiment, Fmi2Slave
+from pythonfmu.enums import Fmi2Status
 
-VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
-    "t_fail": ("s", None, None),
-    "amb_before": ("1", 0.0, 1.0),
-    "amb_after": ("1", 0.0, 1.0),
-    "t_force_on": ("s", None, None),
-    "t_force_off": ("s", None, None),
-    "F_x_step": ("N", None, None),
-    "F_y_step": ("N", None, None),
-    "amb_on": ("1", 0.0, 1.0),
-    "F_x": ("N", None, None),
-    "F_y": ("N", None, None),
-}
+from .variables import OUTPUT, PARAMETER, Var, meta, output, register
 
 TIME_EPS = 1e-9  # s: host clocks that add h repeatedly may land just before an event time
 
-PARAMETERS: tuple[tuple[str, float, str], ...] = (
-    ("t_fail", 1e30, "Time of the bearing failure [s]"),
-    ("amb_before", 1.0, "amb_on before t_fail [1], in [0, 1]"),
-    ("amb_after", 0.0, "amb_on from t_fail on [1], in [0, 1]"),
-    ("t_force_on", 1e30, "Start of the external force step [s]"),
-    ("t_force_off", 1e30, "End of the external force step [s]"),
-    ("F_x_step", 0.0, "External force x during the step [N]"),
-    ("F_y_step", 0.0, "External force y during the step [N]"),
+
+def _param(name: str, start: float, unit: str, description: str, lo: float | None = None,
+           hi: float | None = None) -> Var:
+    return Var(name, PARAMETER, "Real", start, unit, lo, hi, description, tunable=True)
+
+
+TABLE: tuple[Var, ...] = (  # the variable table of this FMU (see .variables)
+    _param("t_fail", 1e30, "s", "Time of the bearing failure"),
+    _param("amb_before", 1.0, "1", "amb_on before t_fail", 0.0, 1.0),
+    _param("amb_after", 0.0, "1", "amb_on from t_fail on", 0.0, 1.0),
+    _param("t_force_on", 1e30, "s", "Start of the external force step"),
+    _param("t_force_off", 1e30, "s", "End of the external force step"),
+    _param("F_x_step", 0.0, "N", "External force x during the step"),
+    _param("F_y_step", 0.0, "N", "External force y during the step"),
+    output("amb_on", "1", "Magnetic bearing state for the step that starts now", 0.0, 1.0),
+    output("F_x", "N", "External force x for the step that starts now"),
+    output("F_y", "N", "External force y for the step that starts now"),
 )
-OUTPUTS: tuple[tuple[str, str], ...] = (
-    ("amb_on", "Magnetic bearing state for the step that starts now [1]"),
-    ("F_x", "External force x for the step that starts now [N]"),
-    ("F_y", "External force y for the step that starts now [N]"),
-)
+VARIABLE_META = meta(TABLE)  # read by build.py
 
 
 class TouchdownEventsAdapter(Fmi2Slave):
@@ -64,17 +58,14 @@ class TouchdownEventsAdapter(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        for name, start, desc in PARAMETERS:
-            setattr(self, name, start)
-            self.register_variable(Real(name, causality=Fmi2Causality.parameter,
-                                        variability=Fmi2Variability.tunable,
-                                        description=desc))
         self._t_now = 0.0   # the outputs are the schedule at this time [s]
-        for name, desc in OUTPUTS:
-            self.register_variable(Real(name, causality=Fmi2Causality.output,
-                                        initial=Fmi2Initial.exact, description=desc,
-                                        getter=self._getter(name)))
+        register(self, TABLE, lambda _name: None, self._refuse,
+                 getters={v.name: self._getter(v.name) for v in TABLE if v.causality == OUTPUT})
         self._t0 = 0.0
+
+    def _refuse(self, name: str) -> Any:
+        return lambda _value: self.log(f"output '{name}' cannot be set by the host",
+                                       Fmi2Status.error)
 
     def _getter(self, name: str) -> Any:
         return lambda: self.schedule(self._t_now)[name]

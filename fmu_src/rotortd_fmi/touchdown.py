@@ -33,7 +33,7 @@ from pythonfmu.enums import Fmi2Status
 
 from . import touchdown_variables as tv
 from .guard import GuardedSlave
-from .variables import meta, register
+from .variables import meta, range_violations, register
 
 STATE_SCHEMA = "rotortd-fmu-state"
 STATE_VERSION = 1
@@ -152,9 +152,7 @@ class RotorTouchdownAdapter(GuardedSlave):
 
     def _require_ranges(self, names: tuple[str, ...]) -> None:
         """Raise one ModelError naming every value outside its declared range."""
-        from rotortd.limits import violations
-
-        found = violations((n, getattr(self, n)) for n in names)
+        found = range_violations((tv.BY_NAME[n] for n in names), self)
         if found:
             raise ModelError("; ".join(found))
 

@@ -92,6 +92,7 @@ TABLE: tuple[Var, ...] = (
            type_="Boolean"),
 )
 
+BY_NAME = {v.name: v for v in TABLE}
 PARAMETERS = names(TABLE, PARAMETER)
 TUNABLE: frozenset[str] = frozenset(names(TABLE, PARAMETER, tunable=True))
 FIXED = names(TABLE, PARAMETER, tunable=False)

@@ -11,6 +11,7 @@ types. Standard library and pythonfmu only; the table is plain data, built once 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -79,12 +80,34 @@ def meta(table: Iterable[Var]) -> dict[str, tuple[str, float | None, float | Non
     return {v.name: (v.unit, v.lo, v.hi) for v in table if v.type in ("Real", "Integer")}
 
 
+def range_message(v: Var, value: Any) -> str | None:
+    """None when ``value`` lies in the row's [lo, hi], else the message naming the
+    variable, its value, unit and range."""
+    x = float(value)
+    lo = -math.inf if v.lo is None else v.lo
+    hi = math.inf if v.hi is None else v.hi
+    if lo <= x <= hi and x - x == 0.0:  # False for NaN and for infinities
+        return None
+    u = f" {v.unit}" if v.unit and v.unit != "1" else ""
+    what = "is not finite" if not math.isfinite(x) else "is out of range"
+    return f"{v.name} = {x!r}{u} {what}: it must lie in [{lo:g}, {hi:g}]{u}"
+
+
+def range_violations(rows: Iterable[Var], slave: Any) -> list[str]:
+    """The message of every row whose current value on ``slave`` is outside its range."""
+    found = (range_message(v, getattr(slave, v.name)) for v in rows)
+    return [msg for msg in found if msg is not None]
+
+
 def register(slave: Any, table: Iterable[Var], watched: Callable[[str], Any],
-             refused: Callable[[str], Any]) -> None:
+             refused: Callable[[str], Any], getters: dict[str, Callable[[], Any]] | None = None
+             ) -> None:
     """Set each start value on ``slave`` and register the variable with PythonFMU.
 
     ``watched(name)`` gives the setter of a parameter or input, ``refused(name)`` that of
-    an output (a host may not set it)."""
+    an output (a host may not set it); ``getters`` replaces the plain attribute read of some
+    variables."""
+    getters = getters or {}
     for v in table:
         setattr(slave, v.name, v.start)
         kwargs: dict[str, Any] = {"causality": getattr(Fmi2Causality, v.causality),
@@ -99,4 +122,6 @@ def register(slave: Any, table: Iterable[Var], watched: Callable[[str], Any],
             if v.causality == PARAMETER:
                 kwargs["variability"] = (Fmi2Variability.tunable if v.tunable
                                          else Fmi2Variability.fixed)
+        if v.name in getters:
+            kwargs["getter"] = getters[v.name]
         slave.register_variable(_TYPES[v.type](v.name, **kwargs))
