@@ -1,6 +1,6 @@
 """Bit-exact behaviour fingerprint of the core and the FMU, compared with an earlier commit.
 
-    python docs/scripts/fingerprint.py --base <commit>        # ~40 s on 2 cores (see below)
+    python docs/scripts/fingerprint.py --base <commit>        # ~40 s on 2 cores (below)
     python docs/scripts/fingerprint.py --base <commit> --allow-rounding --amplification
     python docs/scripts/fingerprint.py                          # this tree only: the hashes
 
@@ -38,21 +38,26 @@ fields) with ``getattr`` and a default, so a renamed field shows up as a differe
 crash.
 
 The table: per job whether it is identical; else the first differing quantity (in time
-order: step row, impact or transition, then the final state), the largest difference in
-scaled units (positions in c_r, velocities in c_r |Omega|, times in 1/|Omega|, forces in
-m c_r Omega^2, impulses in m c_r |Omega|, torques in R m c_r Omega^2, energies in
-m (c_r Omega)^2; other final-state values relative), and whether impact counts and modes
-are equal at every step. Exit 0 iff all jobs are identical; with ``--allow-rounding`` iff
-every difference is <= 1e-13 scaled with equal counts, modes and statuses.
+order: step row, impact or transition, then the final counters and state), the largest
+difference in scaled units, and whether impact counts and modes are equal at every step.
+Scaled units: positions in c_r, velocities in c_r |Omega|, times in 1/|Omega|, angles in
+rad; forces (m c_r Omega^2), impulses (m c_r |Omega|), torques (R m c_r Omega^2) and
+energies (m (c_r Omega)^2) against the larger of that unit and their own size, since a
+step-averaged P/h at 1e-5 s or the cumulative E_diss is many units large and rounds
+relative to it; other final-state values relative; ``inf`` where a value is missing,
+non-finite or not a number on one side (e.g. the sliding step memo ``H``). Exit 0 iff all
+jobs are identical; with ``--allow-rounding`` iff every difference is <= 1e-13 scaled with
+equal counts, modes and statuses (work counters may differ).
 
 ``--amplification`` measures, per scene on the current tree at 1e-3 s, how much a 1e-12
 scaled perturbation of the initial state (+-x, +-y in c_r, +-vx, +-vy in c_r |Omega|) grows:
 the largest scaled state difference over the run divided by 1e-12. Only on scenes with an
 amplification <= 10 can a rounding-only change be judged by its size.
 
-Run time (2 cores, base and head in parallel): about 40 s for the default set, of which the
-core recordings take ~25 s per tree; ``--amplification`` adds ~10 s; ``--no-fmu`` saves the
-two FMU builds and runs (~10 s).
+Run time (2 cores, base and head in parallel): 35-45 s for the default set, measured while
+other sessions kept the load average near 14; per tree ~28 s CPU for the core recordings,
+~4 s for the FMU runs and ~1.5 s for its build; ``--amplification`` adds ~5-10 s, ``--no-fmu``
+saves the FMU part. The temporary files (~55 MB per tree) are removed unless ``--keep``.
 """
 
 from __future__ import annotations
@@ -619,8 +624,11 @@ def tree_env(tree: Path) -> dict[str, str]:
 
 
 def add_worktree(commit: str, path: Path) -> None:
-    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "--quiet",
-                    str(path), commit], check=True)
+    """A detached worktree of ``commit`` at ``path``; exits with git's message if refused."""
+    proc = subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "--quiet",
+                           str(path), commit], capture_output=True, text=True)
+    if proc.returncode:
+        raise SystemExit(f"git worktree add {commit} failed: {proc.stderr.strip()}")
 
 
 def remove_worktree(path: Path) -> None:
@@ -680,7 +688,7 @@ def record_tree(tree: Path, specs: list[Spec], jobs: list[tuple[str, str, str]],
 TIME_KEYS = {"t", "t_lo", "t_last", "t_contact", "t_last_impact", "t_contact_entry", "H",
              "h", "time"}
 POS_KEYS = {"z", "x", "y", "x0", "y0"}
-VEL_KEYS = {"v", "vx", "vy", "v_last", "v_last_impact", "slip", "rdot", "vx_minus",
+VEL_KEYS = {"v", "vx", "vy", "v_last", "v_last_impact", "rdot", "vx_minus",
             "vy_minus", "vx_plus", "vy_plus", "v_rel", "vx0", "vy0"}
 RATE_KEYS = {"dtheta", "whirl_rate", "Omega", "Omega_out"}
 ANGLE_KEYS = {"psi", "theta", "psi0", "r_rel", "u_re", "u_im", "du_re", "du_im"}
@@ -689,7 +697,11 @@ IMPULSE_KEYS = {"P_n", "P_t"}
 TORQUE_KEYS = {"T_f"}
 ENERGY_KEYS = {"E_diss", "E_diss_step"}
 COUNT_KEYS = {"n_impacts", "n_impacts_step", "n_transitions"}
-MODE_KEYS = {"mode", "mode_step", "in_contact"}
+MODE_KEYS = {"mode", "mode_step", "in_contact", "slip", "locked", "on_wall"}
+"""Discrete state: a difference clears "modes equal" (slip is the sliding direction)."""
+SIZED_KEYS = FORCE_KEYS | IMPULSE_KEYS | TORQUE_KEYS | ENERGY_KEYS
+"""Measured against max(unit, |value|): a step-averaged force P/h at a small step, or the
+cumulative E_diss, is many units large, and its rounding is relative to its size."""
 
 
 def scales(spec: Spec) -> dict[str, float]:
@@ -707,17 +719,16 @@ def scales(spec: Spec) -> dict[str, float]:
     return out
 
 
-def scaled_diff(a: float, b: float, unit: float | None) -> float:
-    """|a - b| in units of ``unit`` (relative if None); 0 for equal bits, inf for NaN vs
-    a number."""
+def scaled_diff(a: float, b: float, unit: float | None, sized: bool = False) -> float:
+    """|a - b| in units of ``unit``, or of max(unit, |a|, |b|) if ``sized``, or relative if
+    ``unit`` is None; 0 for equal values, inf for NaN or inf against a number."""
     if a == b or (math.isnan(a) and math.isnan(b)):
         return 0.0
-    if math.isnan(a) or math.isnan(b):
+    if not (math.isfinite(a) and math.isfinite(b)):
         return math.inf
     if unit is None:
-        den = max(abs(a), abs(b))
-        return abs(a - b) / den if den else 0.0
-    return abs(a - b) / unit
+        return abs(a - b) / max(abs(a), abs(b))
+    return abs(a - b) / (max(unit, abs(a), abs(b)) if sized else unit)
 
 
 class Verdict:
@@ -776,7 +787,8 @@ def compare_tables(v: Verdict, a: Any, b: Any, cols: list[str], units: dict[str,
         flag_difference(v, name)
         if name in units:
             for x, y in zip(a[:n, j][diff[:, j]], b[:n, j][diff[:, j]]):
-                v.max_scaled = max(v.max_scaled, scaled_diff(float(x), float(y), units[name]))
+                v.max_scaled = max(v.max_scaled, scaled_diff(float(x), float(y), units[name],
+                                                             name in SIZED_KEYS))
 
 
 def flag_difference(v: Verdict, name: str) -> None:
@@ -839,7 +851,8 @@ def compare_final(v: Verdict, a: dict[str, Any], b: dict[str, Any], units: dict[
         flag_difference(v, name)
         fx, fy = _as_float(x), _as_float(y)
         if fx is not None and fy is not None:
-            v.max_scaled = max(v.max_scaled, scaled_diff(fx, fy, _unit_of(key, units)))
+            sized = bool(SIZED_KEYS & set(key.split(".")))
+            v.max_scaled = max(v.max_scaled, scaled_diff(fx, fy, _unit_of(key, units), sized))
         elif name not in COUNT_KEYS | MODE_KEYS:
             v.max_scaled = math.inf
 
@@ -984,12 +997,21 @@ def summarise(verdicts: list[Verdict], amps: dict[str, Any], allow_rounding: boo
     print(f"{same}/{len(verdicts)} jobs identical, {len(rounding)} within rounding "
           f"(<= {ROUNDING:g} scaled, equal counts and modes); {secs:.0f} s")
     if amps:
-        low = sorted(n for n, a in amps.items() if a.get("amplification", math.inf) <= 10)
-        print(f"amplification <= 10 (rounding judgeable; * = a perturbed run changed the "
-              f"impact count): {', '.join(low) or 'none'}")
+        print_judgeable(verdicts, amps)
     if same == len(verdicts):
         return 0
     return 0 if allow_rounding and same + len(rounding) == len(verdicts) else 1
+
+
+def print_judgeable(verdicts: list[Verdict], amps: dict[str, Any]) -> None:
+    """The scenes whose amplification is <= 10, and how their core jobs fared."""
+    low = sorted(n for n, a in amps.items() if a.get("amplification", math.inf) <= 10)
+    print(f"amplification <= 10 (rounding judgeable; * in amp = a perturbed run changed the "
+          f"impact count): {', '.join(low) or 'none'}")
+    mine = [v for v in verdicts if v.job[0] == "core" and v.job[1] in low]
+    print(f"  their {len(mine)} core jobs: {sum(v.identical for v in mine)} identical, "
+          f"{sum(not v.identical and v.rounding_only() for v in mine)} within rounding, "
+          f"{sum(not v.rounding_only() for v in mine)} beyond")
 
 
 def main(argv: list[str] | None = None) -> int:
