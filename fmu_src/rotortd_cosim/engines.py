@@ -14,6 +14,9 @@ Engine differences handled here (see docs/cosimulation.md):
   amb_on = 0, F = 0 whatever the upstream outputs are.
 - libcosim counts time in integer nanoseconds: the step is passed as round(h * 1e9).
 - ecos: the bundled binaries need chmod +x; the native CLI needs LD_PRELOAD of libpython.
+  Both ecospy and the CLI need libtbb.so.12: from the environment's ``tbb`` package,
+  loaded by :func:`.tbb.load_libtbb` before ecospy is imported, and put on
+  LD_LIBRARY_PATH for the CLI.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from .scenes import RECORDED, SCENES, Scene
+from .tbb import load_libtbb
 
 Result = dict[str, np.ndarray]
 COLUMNS = [f"{c}.{v}" for c, v in RECORDED]
@@ -128,6 +132,7 @@ def ecos_binaries() -> Path:
 def run_ecospy(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
     """ecospy (Python binding of ecos) from the SSP."""
     ecos_binaries()
+    load_libtbb()
     from ecospy import EcosSimulation
 
     n, _ = _steps(scene, step, stop)
@@ -154,6 +159,17 @@ def libpython() -> str:
     return str(Path(libdir) / name)
 
 
+def ecos_cli_env() -> dict[str, str]:
+    """The environment for the native ecos CLI: LD_PRELOAD of libpython (for the PythonFMU
+    FMUs) and the environment's libtbb directory first on LD_LIBRARY_PATH."""
+    env = dict(os.environ, LD_PRELOAD=libpython())
+    lib = load_libtbb()
+    if lib is not None:
+        paths = [str(lib.parent), *filter(None, env.get("LD_LIBRARY_PATH", "").split(":"))]
+        env["LD_LIBRARY_PATH"] = ":".join(dict.fromkeys(paths))
+    return env
+
+
 def ecos_cli_command(ssp: Path, scene: Scene, step: float, stop: float) -> list[str]:
     """The native ecos command line for a scene (see docs/cosimulation.md); it writes
     <ssp stem>.csv with every variable into the working directory."""
@@ -163,11 +179,11 @@ def ecos_cli_command(ssp: Path, scene: Scene, step: float, stop: float) -> list[
 
 
 def run_ecos_cli(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
-    """The native ecos CLI; needs LD_PRELOAD of libpython for the PythonFMU FMUs."""
+    """The native ecos CLI, in the environment of :func:`ecos_cli_env`."""
     n, _ = _steps(scene, step, stop)
     work = Path(tempfile.mkdtemp(prefix="rotortd_ecos_"))
     try:
-        env = dict(os.environ, LD_PRELOAD=libpython())
+        env = ecos_cli_env()
         # ecos accumulates t += h in floating point and stops before a stop time it
         # would overshoot by round-off: ask for half a step more, keep n rows
         cmd = ecos_cli_command(ssp.resolve(), scene, step, (n + 0.5) * step)
