@@ -14,9 +14,10 @@ external force and Omega constant the free flight is
 
     U'' + (gamma + 2i) U' + (omega^2 - 1 + i gamma) U = rho e^{i phi}    (|U| < 1).
 
-Everything here is pure Python (``math``/``cmath``). The functions are written to give the
-same bits as the expressions they replace in the core (see the notes on each), so that the
-core can call them without any change in its results.
+Everything here is pure Python (``math``/``cmath``). The parameter conversions are those of
+``RotorParams`` (``scaled``, ``from_scaled``); the state conversions and ``wrap_angle`` are
+written to give the same bits as the core's own expressions (see the notes on each), so that
+the core can call them without any change in its results.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ import cmath
 import math
 from dataclasses import replace
 
-from .params import ParameterError, RotorParams, ScaledParams, check_finite, check_range
+from .params import RotorParams, ScaledParams
 
 TWO_PI_HI = 6.283185307179586
 """2 pi rounded to a double (rad)."""
@@ -68,25 +69,10 @@ def wrap_angle(x: float) -> float:
 def scaled_params(p: RotorParams, Omega: float) -> ScaledParams:
     """The scaled set of the SI parameters ``p`` at spin speed ``Omega`` (rad/s).
 
-    ParameterError at Omega = 0 or non-finite. Same bits and messages as
-    ``RotorParams.scaled``.
+    ParameterError at Omega = 0 or non-finite. The conversion itself is
+    ``RotorParams.scaled`` (one implementation, next to the parameter validation).
     """
-    W = check_finite("Omega", Omega)
-    if W == 0.0:
-        raise ParameterError(
-            "Omega = 0.0 rad/s: the scaled set (gamma, omega, rho) is undefined; "
-            "it needs Omega != 0"
-        )
-    w = abs(W)
-    return ScaledParams(
-        gamma=p.c / (p.m * w),
-        omega=math.sqrt(p.k / p.m) / w,
-        rho=p.e_c / p.c_r,
-        phi=p.phi,
-        mu=p.mu,
-        d=p.d,
-        R_over_cr=p.R / p.c_r,
-    )
+    return p.scaled(Omega)
 
 
 def si_params(
@@ -101,30 +87,10 @@ def si_params(
     """SI parameters realising the scaled set ``sp`` at ``Omega`` (rad/s), mass ``m`` (kg)
     and clearance ``c_r`` (m); gravity ``g`` (m/s^2) in -y, bias on when ``levitate``.
 
-    Same bits and messages as ``RotorParams.from_scaled`` (whose defaults are also the
-    chapter's m and c_r); the default Omega is the chapter's.
+    The conversion itself is ``RotorParams.from_scaled``; here the default Omega, m and c_r
+    are the chapter's. ParameterError names an invalid value.
     """
-    W = check_finite("Omega", Omega)
-    if W == 0.0:
-        raise ParameterError("Omega = 0.0 rad/s: a scaled set needs Omega != 0")
-    check_range("gamma", sp.gamma, 0.0)
-    check_range("omega", sp.omega, 0.0)
-    check_range("rho", sp.rho, 0.0)
-    check_range("R_over_cr", sp.R_over_cr, 0.0, lo_open=True)
-    w = abs(W)
-    return RotorParams(
-        m=m,
-        c=sp.gamma * m * w,
-        k=m * (sp.omega * w) ** 2,
-        e_c=sp.rho * c_r,
-        phi=sp.phi,
-        c_r=c_r,
-        R=sp.R_over_cr * c_r,
-        mu=sp.mu,
-        d=sp.d,
-        g=g,
-        levitate=levitate,
-    )
+    return RotorParams.from_scaled(sp, Omega, m=m, c_r=c_r, g=g, levitate=levitate)
 
 
 def chapter_params(Omega: float = CHAPTER_OMEGA, **overrides: float) -> ScaledParams:
