@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import cmath
 import json
 import math
 import os
@@ -15,8 +14,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from rotortd import MODE_ROLLING, MODE_SLIDING
+from rotortd.scaled import regular_equilibrium
 from rotortd_tools import sweep as sw
 from rotortd_tools.cli import main
+from rotortd_tools.sweep import spec as sweep_spec
 
 SHORT = sw.Settings(transient=60.0, record=30.0)
 
@@ -45,7 +46,7 @@ def _assert_identical(ra: dict[str, dict], rb: dict[str, dict]) -> None:
 
 def _cycles_available() -> bool:
     try:
-        sw._cycle_finder()
+        sw.cycle_finder()
     except ImportError:
         return False
     return True
@@ -98,7 +99,7 @@ def test_missing_cycles_module_gives_clear_error(monkeypatch):
     def broken():
         raise ImportError("No module named 'rotortd_tools.cycles'")
 
-    monkeypatch.setattr(sw, "_cycle_finder", broken)
+    monkeypatch.setattr(sweep_spec, "cycle_finder", broken)
     with pytest.raises(sw.SweepError, match=r"'cycle' start needs rotortd_tools\.cycles"):
         sw.parse_spec(["gamma=0.1:0.2:3"], "rest,cycle")
     sw.parse_spec(["gamma=0.1:0.2:3"], "rest,steady,large,up,down:steady")
@@ -149,7 +150,7 @@ def _run(gamma: float, start: str, settings: sw.Settings | None = None) -> dict:
 def test_chapter_regimes_from_named_starts():
     """Free whirl at |U*| from 'steady' above the BEB; rub from rest at 0.3; whip at 0.065."""
     sp = sw.point_params({"gamma": 0.3})[2]
-    u_star = abs(sp.rho * cmath.exp(1j * sp.phi) / complex(sp.omega**2 - 1, sp.gamma))
+    u_star = abs(regular_equilibrium(sp))
     free = _run(0.3, "steady")
     assert free["regime"] == "free" and free["n_impacts"] == 0
     assert free["r_max"] == pytest.approx(u_star, abs=1e-9)

@@ -5,8 +5,9 @@
     rotortd sweep-plot S.parquet -o diagram.png
 
 RESULT.csv is an FMPy result file (``fmpy simulate ... --output-file RESULT.csv``).
-``sweep`` and ``sweep-plot`` are described in docs/sweeps.md (code: ``sweep.py``,
-``sweep_plot.py``); a bad sweep specification prints an error and exits with status 2.
+``sweep`` and ``sweep-plot`` are described in docs/sweeps.md (code: the package
+``rotortd_tools.sweep`` and ``sweep_plot.py``); a bad sweep specification prints an error and
+exits with status 2.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Bifurcation diagrams and regime maps from a sweep's Parquet output.
 
-Units as in ``sweep.py``: r in c_r, impact normal speeds in c_r Omega, angles in rad,
+Units as in ``rotortd_tools.sweep``: r in c_r, impact normal speeds in c_r Omega, angles in rad,
 parameters scaled (Omega in rad/s). Analytic markers:
 
 - the boundary equilibrium bifurcation (BEB), where the regular equilibrium
@@ -24,6 +24,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from rotortd import scaled
+from rotortd.scaled import regular_equilibrium
 
 from rotortd_tools.sweep import (
     PARAM_NAMES,
@@ -97,15 +99,15 @@ def beb_values(name: str, lo: float, hi: float, fixed: dict[str, float],
 def _u_star_excess(values: dict[str, float]) -> float:
     """|U*| - 1 at a point (positive: the free whirl leaves the clearance)."""
     _, _, sp = point_params(values)
-    den = complex(sp.omega**2 - 1.0, sp.gamma)
-    return sp.rho / abs(den) - 1.0 if den != 0 else math.inf
+    try:
+        return abs(regular_equilibrium(sp)) - 1.0
+    except ZeroDivisionError:  # undamped resonance: no steady whirl
+        return math.inf
 
 
 def gamma_beb(fixed: dict[str, float]) -> float:
     """gamma_BEB = sqrt(rho^2 - (1 - omega^2)^2) for the sweep's other parameters (or NaN)."""
-    _, _, sp = point_params(fixed)
-    disc = sp.rho**2 - (1.0 - sp.omega**2) ** 2
-    return math.sqrt(disc) if disc >= 0.0 else math.nan
+    return scaled.gamma_beb(point_params(fixed)[2])
 
 
 def chapter_events(path: Path | None) -> list[tuple[str, float]]:

@@ -1,0 +1,74 @@
+"""Where a run starts: the named starts of a sweep point and continuation from a state.
+
+Scaled co-rotating frame (MODEL.md §2, U = z e^{-i psi}/c_r), the point's SI realisation
+for the core:
+
+  rest            U = 0, U' = 0
+  steady          on the regular equilibrium U* (free whirl); "no-start" when inadmissible
+  large           U = 0.9 U*/|U*|, inertial velocity 0 (released near the wall, no whirl)
+  cycle[:BRANCH]  right after the impact of the period-one impacting cycle found by Newton
+                  on the impact map (``rotortd_tools.cycles.find_period_one_cycle``)
+  up[:SEED], down[:SEED]
+                  continuation along the first swept parameter: each point starts from the
+                  previous point's final state (``get_state``/``set_state``, exact); the
+                  first point of a pass (and any point after a failed one) starts from SEED
+                  (rest by default). One chain per value of the second parameter.
+"""
+
+from __future__ import annotations
+
+from rotortd import ParameterError, RotorParams, ScaledParams, TouchdownCore
+from rotortd.scaled import regular_equilibrium
+
+from rotortd_tools.sweep.spec import CONTINUATION, SCALED_NAMES, SweepError, cycle_finder
+
+
+class NoStart(RuntimeError):
+    """A start does not exist at this point (inadmissible whirl, no cycle)."""
+
+
+def make_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams) -> TouchdownCore:
+    """A core at the named simple start (rest, steady, large, cycle[:BRANCH])."""
+    head, _, branch = label.partition(":")
+    if head == "rest":
+        return TouchdownCore(p)
+    U_star = regular_equilibrium(sp)
+    if head == "steady":
+        try:
+            return TouchdownCore.on_steady_whirl(p, Omega)
+        except ParameterError as exc:
+            raise NoStart(str(exc)) from None
+    if head == "large":
+        U0 = 0.9 * U_star / abs(U_star) if abs(U_star) > 0 else 0.9 + 0j
+        return TouchdownCore(p, p.c_r * U0, 0j)
+    if head == "cycle":
+        return _cycle_start(p, Omega, sp, branch)
+    raise SweepError(f"unknown start {label!r}")
+
+
+def _cycle_start(p: RotorParams, Omega: float, sp: ScaledParams, branch: str) -> TouchdownCore:
+    find = cycle_finder()
+    overrides = {k: getattr(sp, k) for k in SCALED_NAMES if k != "gamma"}
+    kwargs = {"branch": branch} if branch else {}
+    try:
+        cyc = find(sp.gamma, **kwargs, **overrides)
+    except (KeyError, RuntimeError, ValueError, ArithmeticError) as exc:
+        raise NoStart(f"no period-one cycle: {type(exc).__name__}: {exc}") from None
+    return TouchdownCore.from_scaled(p, Omega, complex(cyc.U0), complex(cyc.dU0))
+
+
+
+def core_for(start: str, p: RotorParams, Omega: float, sp: ScaledParams,
+              state: dict | None) -> TouchdownCore:
+    """A core at the start, or continued from ``state`` with the point's parameters."""
+    head, _, seed = start.partition(":")
+    if head in CONTINUATION:
+        if state is None:
+            return make_start(seed or "rest", p, Omega, sp)
+        core = TouchdownCore(p)
+        core.set_state(state)
+        core.set_params(p)
+        return core
+    return make_start(start, p, Omega, sp)
+
+
