@@ -16,10 +16,12 @@ left out because Omega is held constant within a segment. While ``|z| < c_r`` th
 ``[x, y, vx, vy]`` is integrated directly. Impacts at ``|z| = c_r`` are located with a terminal
 event ``x^2 + y^2 - c_r^2 = 0`` (direction +1) on the dense output, z is projected onto the
 circle, and the velocity is reset with MODEL.md eq. (2) plus the Coulomb stick cap. A tangential
-touch that the integrator steps over (both step ends inside the disk) is found afterwards by
-scanning each accepted step's dense output for an interior maximum of ``r``. After a reset, the
-first ``~delta/|rdot^+|`` (delta = a few ulp of c_r) is taken with a Taylor step so the event
-cannot re-detect the same impact (see :func:`_restart_free`).
+touch that the integrator steps over (both step ends inside the disk) is found afterwards from
+each accepted step's dense output, a polynomial: a bound on its curvature clears the steps that
+stay inside, and on the others ``r`` is evaluated at every interior maximum (roots of the
+derivative); an overshoot of more than a few ulp is an impact (see :func:`_missed_graze`). After
+a reset, the first ``~delta/|rdot^+|`` (delta = a few ulp of c_r) is taken with a Taylor step so
+the event cannot re-detect the same impact (see :func:`_restart_free`).
 
 Sustained contact, integrated in ``(theta, theta')`` with MODEL.md eq. (3)::
 
@@ -346,32 +348,119 @@ def _wall_gap(c_r: float) -> Callable[[float, np.ndarray], float]:
     return gap
 
 
-def _missed_graze(sol: Any, gap: Callable[[float, np.ndarray], float], t_stop: float
-                  ) -> float | None:
-    """First wall crossing inside a step whose two ends are both inside the disk, or None.
+#: Degree bound of the dense output of every solve_ivp method on one step (a polynomial in t):
+#: LSODA's Adams orders go up to 12; DOP853 is 7, RK45 4, RK23 and Radau 3, BDF at most 5. The
+#: gap r^2/c_r^2 - 1 is then a polynomial of degree <= 2 _DENSE_DEG on each step.
+_DENSE_DEG = 12
 
-    Scans the accepted steps of the dense output ``sol`` (an OdeSolution) up to ``t_stop``; a step
-    with ``r r'`` going from + to - and an end near the wall is searched for its maximum of r.
-    """
+
+def _cheb_tables(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Tables for polynomials of degree <= n on [-1, 1] sampled at the Chebyshev-Lobatto nodes
+    u_k = -cos(pi k / n) (ascending): the nodes, the matrix ``C`` of their Chebyshev coefficients
+    (``a = C @ f``, a discrete cosine transform of type I in closed form), the matrix ``D`` of the
+    derivative on coefficients (``a' = D @ a``) and ``E`` of the values at the nodes
+    (``f = E @ a``)."""
+    u = np.array([-math.cos(math.pi * k / n) for k in range(n + 1)])
+    u[0], u[-1] = -1.0, 1.0
+    c = np.empty((n + 1, n + 1))
+    e = np.empty((n + 1, n + 1))
+    for j in range(n + 1):
+        for k in range(n + 1):
+            w = (0.5 if k in (0, n) else 1.0) * (0.5 if j in (0, n) else 1.0)
+            cos_jk = math.cos(j * (math.pi - math.pi * k / n))  # T_j(u_k)
+            c[j, k] = 2.0 / n * w * cos_jk
+            e[k, j] = cos_jk
+    d = np.zeros((n + 1, n + 1))  # T_j' = 2 j sum(T_i, i < j, j - i odd), T_0 counted once
+    for j in range(1, n + 1):
+        for i in range(j - 1, -1, -2):
+            d[i, j] = float(j if i == 0 else 2 * j)
+    return u, c, d, e
+
+
+_U, _C, _D, _E = _cheb_tables(2 * _DENSE_DEG)
+#: Node values of G -> values of G' at the nodes; node values of G -> coefficients of G''.
+_VAL_D1 = _E @ _D @ _C
+_VAL_D2 = _D @ _D @ _C
+_DU = np.diff(_U)
+#: Rounding of the gap at a node (dense output and r^2/c_r^2 - 1) is taken as <= _G_NOISE, and its
+#: worst-case effect on G' at a node and on the sum of the |coefficients| of G'' is added to the
+#: bounds, so that rounding can only make them weaker.
+_G_NOISE = 16.0 * _EPS
+_D1_NOISE = _G_NOISE * float(np.abs(_VAL_D1).sum(1).max())
+_D2_NOISE = _G_NOISE * float(np.abs(_VAL_D2).sum())
+
+
+def _step_critical_points(gc: np.ndarray) -> np.ndarray:
+    """Points u in (-1, 1) that include every critical point of the polynomial with Chebyshev
+    coefficients gc: the real, or nearly real (a double root that rounding split into a complex
+    pair), roots of its derivative, from the eigenvalues of the Chebyshev companion matrix."""
+    cheb = np.polynomial.chebyshev
+    dg = cheb.chebder(gc)
+    dg = cheb.chebtrim(dg, tol=64.0 * _EPS * float(np.max(np.abs(dg), initial=0.0)))
+    if dg.size < 2:
+        return np.empty(0)
+    r = cheb.chebroots(dg)
+    r = r[np.abs(np.imag(r)) <= 1e-3].real
+    return np.sort(r[(r > -1.0) & (r < 1.0)])
+
+
+def _missed_graze(sol: Any, gap: Callable[[float, np.ndarray], float], t_stop: float,
+                  c_r: float) -> float | None:
+    """First wall crossing at an interior maximum of r in an accepted step, or None.
+
+    The event sees the sign of the gap G = r^2/c_r^2 - 1 at the ends of a step only; a graze inside
+    one step (or a chord that grazes the wall and then passes the centre, so that r has a maximum
+    and a minimum in the step) has no sign change there. On each step of ``sol`` (an OdeSolution)
+    up to ``t_stop``, G is a polynomial of degree <= 2 _DENSE_DEG in the scaled time u in [-1, 1],
+    recovered (up to rounding) from the dense output at 2 _DENSE_DEG + 1 Chebyshev-Lobatto nodes.
+    The Chebyshev coefficients c_j of G'' bound it on the step (|T_j| <= 1): G'' >= c_0 - sum
+    |c_j|, |G''| <= sum |c_j|, widened by the worst case of the rounding at the nodes. A step is
+    cleared without a root search when G is convex on it (no interior maximum), or when each
+    interval between two nodes is either below the wall (G <= max(G_k, G_k+1) + max(-G'') du^2/8
+    < 0) or monotone (G'_k + G'_k+1 beyond max|G''| du) with no crossing inside. On the other
+    steps G is evaluated on the dense output at every critical point (roots of G'); G is monotone
+    between them, so the first one with G > _GAP_MARGIN eps brackets the first crossing, which
+    brentq locates. An overshoot below that (a few ulp of c_r) is within the rounding of G and is
+    not an impact. The decision rests on the value of G at its maxima, not on samples or on signs
+    at the step ends, so an overshoot far above rounding is found whatever the step sequence,
+    which, where the solution is nearly polynomial, the rounding of the error estimate decides."""
     ts = np.asarray(sol.ts)
-    ts = ts[ts <= t_stop]
-    if ts.size < 2:
+    n_steps = int(np.count_nonzero(ts[1:] <= t_stop))
+    if n_steps < 1:
         return None
-    y = sol(ts)
-    g = np.array([gap(0.0, y[:, j]) for j in range(ts.size)])
-    rr = (y[0] * y[2] + y[1] * y[3]) / (y[0] ** 2 + y[1] ** 2 + 1e-300)  # rdot / r [1/s]
-    h = np.diff(ts)
-    cand = np.nonzero((rr[:-1] > 0.0) & (rr[1:] <= 0.0)
-                      & (np.maximum(g[:-1] + 4.0 * rr[:-1] * h, g[1:] - 4.0 * rr[1:] * h) > 0.0)
-                      & (g[:-1] < 0.0) & (g[1:] < 0.0))[0]
+    ip = sol.interpolants
+    half = 0.5 * np.diff(ts[:n_steps + 1])
+    tt = ts[:n_steps, None] + half[:, None] * (1.0 + _U)
+    tt[:, 0], tt[:, -1] = ts[:n_steps], ts[1:n_steps + 1]
+    q = np.array([ip[j](tt[j])[:2] for j in range(n_steps)])  # (steps, 2, nodes)
+    gn = (q[:, 0] ** 2 + q[:, 1] ** 2) / (c_r * c_r) - 1.0
+    d1 = gn @ _VAL_D1.T  # G' at the nodes
+    c2 = gn @ _VAL_D2.T  # Chebyshev coefficients of G''
+    tail = np.abs(c2[:, 1:]).sum(1) + _D2_NOISE
+    neg_curv = np.maximum(tail - c2[:, 0], 0.0)  # >= max(-G'') on the step (|T_j| <= 1)
+    lip = np.abs(c2[:, 0]) + tail  # >= max|G''|
+    below = (np.maximum(gn[:, :-1], gn[:, 1:]) + _G_NOISE
+             + neg_curv[:, None] * (_DU * _DU / 8.0) < 0.0)
+    slope = d1[:, :-1] + d1[:, 1:]
+    mono = lip[:, None] * _DU + 2.0 * _D1_NOISE
+    up = slope > mono
+    clear = below | ((-slope > mono) & (gn[:, :-1] < 0.0)) | (up & (gn[:, 1:] < 0.0))
+    clear[:, -1] |= up[:, -1]  # rising to the step's end: a crossing there is the event's
+    cand = np.nonzero((gn[:, 0] < 0.0) & (neg_curv > 0.0) & ~clear.all(1))[0]
     for j in cand:
-        def rdot(t: float) -> float:
-            q = sol(t)
-            return q[0] * q[2] + q[1] * q[3]
+        def g_of(t: float, f: Any = ip[j]) -> float:
+            return gap(0.0, f(t))
 
-        t_max = ts[j + 1] if rr[j + 1] == 0.0 else brentq(rdot, ts[j], ts[j + 1], xtol=4 * _EPS)
-        if gap(0.0, sol(t_max)) > 0.0:
-            return float(brentq(lambda t: gap(0.0, sol(t)), ts[j], t_max, xtol=4 * _EPS))
+        t_neg = float(ts[j])
+        for u in _step_critical_points(gn[j] @ _C.T):
+            t = float(ts[j] + half[j] * (1.0 + u))
+            if t <= t_neg or t >= ts[j + 1]:
+                continue
+            gt = g_of(t)
+            if gt > _GAP_MARGIN * _EPS:
+                return float(brentq(g_of, t_neg, t, xtol=4 * _EPS))
+            if gt < 0.0:
+                t_neg = t
     return None
 
 
@@ -384,7 +473,7 @@ def _free_phase(fc: Forcing, st: _State, opts: _Opts, t_end: float) -> _Phase:
     if res.status < 0:
         return _Phase(st.t, "fail", y0, res.nfev, message=res.message)
     t_stop = float(res.t[-1])
-    t_graze = _missed_graze(res.sol, gap, t_stop)
+    t_graze = _missed_graze(res.sol, gap, t_stop, fc.par.c_r)
     if t_graze is not None:
         return _Phase(t_graze, "impact", res.sol(t_graze), res.nfev, res.sol)
     if res.status == 1:
