@@ -4,9 +4,8 @@ Examples: 10,000 by default (``ROTORTD_FUZZ_EXAMPLES`` overrides), with a fixed 
 no example database, so every run replays the same stream.
 
 Every example must finish every step with status OK, no NaN, |z| <= c_r (1 + 1e-12) and
-the work counter within its documented cap. To keep the run affordable, a step covers at
-most MAX_RADIANS of the scene's fastest rate (the cap itself scales with h w_max, so this
-bounds wall time, not what is checked).
+the work counter within its documented bound (the constant WORK_MAX, docs/model.md 7). To
+keep the run affordable, a step covers at most MAX_RADIANS of the scene's fastest rate.
 """
 
 from __future__ import annotations
