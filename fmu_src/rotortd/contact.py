@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 from . import gbs
 from .divdiff import dd2
-from .events import G2_FLOOR
+from .events import G2_FLOOR, WORK_MAX
 from .params import RotorParams
 
 RTOL = 1e-13
@@ -49,8 +49,10 @@ SCALE_FLOOR = 2.2250738585072014e-308
 forces (a 1e-313 N load, no spin, no stiffness) the scale RTOL * force * step underflowed
 to 0 and the error ratio divided by it (fuzzing). Far below any resolvable integral, it
 changes no scale that does not underflow."""
-MAX_STEPS = 2000
-"""Cap on integrator steps in one sliding segment, plus 50 per maximal step in it."""
+GBS_STEP_WORK = 8
+"""Work units charged per extrapolated step of the sliding integrator on top of its
+right-hand-side evaluations: the extrapolation tableau, error norm, event test and step
+control cost about as much as 8 evaluations (measured; docs/model.md 7)."""
 MAX_ROOT_ITERS = 200
 """Cap on conservative-advancement iterations for one rolling exit search."""
 
@@ -246,43 +248,46 @@ class Sliding:
             self.mus, self.nu,
         )
         exp, cos, sin = cmath.exp, math.cos, math.sin
-        h = H / n
-        h2 = 2.0 * h
-        m0, m1, m2, m3, m4, m5 = y0  # the previous midpoint iterate, then the current one
-        c0, c1, c2 = m0 + h * f0[0], m1 + h * f0[1], m2 + h * f0[2]
-        c3, c4, c5 = m3 + h * f0[3], m4 + h * f0[4], m5 + h * f0[5]
-        for i in range(1, n + 1):
-            euE = eu * (E0 * exp(iW * (u0 + i * h if i < n else u0 + H)))
-            Q = q0 + euE
-            Qr, Qi = Q.real, Q.imag
-            co, sn = cos(c0), sin(c0)
-            gn = (Qr * co + Qi * sn) - kappa + c1 * c1
-            ft = mus * gn
-            f1 = (Qi * co - Qr * sn) - beta * c1 - ft
-            if nu == 0.0:
-                f3, f4 = ft * sn - gn * co, -(gn * sn) - ft * co
-            else:
-                V = W * euE - c1 * Q
-                ar, ai = (V.real * sn - V.imag * co) + 2.0 * c1 * f1, (c1 - nu) * gn
-                br, bi = ar - mus * ai, ai + mus * ar
-                f3, f4 = bi * sn - br * co, -(br * sn) - bi * co
-            f5 = ft * (wr + c1)
-            if i == n:
-                break
-            m0, c0 = c0, m0 + h2 * c1
-            m1, c1 = c1, m1 + h2 * f1
-            m2, c2 = c2, m2 + h2 * gn
-            m3, c3 = c3, m3 + h2 * f3
-            m4, c4 = c4, m4 + h2 * f4
-            m5, c5 = c5, m5 + h2 * f5
-        return [
-            0.5 * (c0 + m0 + h * c1),
-            0.5 * (c1 + m1 + h * f1),
-            0.5 * (c2 + m2 + h * gn),
-            0.5 * (c3 + m3 + h * f3),
-            0.5 * (c4 + m4 + h * f4),
-            0.5 * (c5 + m5 + h * f5),
-        ]
+        try:  # an overflowing trial step (cos(inf)) is rejected by its NaN error ratio
+            h = H / n
+            h2 = 2.0 * h
+            m0, m1, m2, m3, m4, m5 = y0  # the previous midpoint iterate, then the current one
+            c0, c1, c2 = m0 + h * f0[0], m1 + h * f0[1], m2 + h * f0[2]
+            c3, c4, c5 = m3 + h * f0[3], m4 + h * f0[4], m5 + h * f0[5]
+            for i in range(1, n + 1):
+                euE = eu * (E0 * exp(iW * (u0 + i * h if i < n else u0 + H)))
+                Q = q0 + euE
+                Qr, Qi = Q.real, Q.imag
+                co, sn = cos(c0), sin(c0)
+                gn = (Qr * co + Qi * sn) - kappa + c1 * c1
+                ft = mus * gn
+                f1 = (Qi * co - Qr * sn) - beta * c1 - ft
+                if nu == 0.0:
+                    f3, f4 = ft * sn - gn * co, -(gn * sn) - ft * co
+                else:
+                    V = W * euE - c1 * Q
+                    ar, ai = (V.real * sn - V.imag * co) + 2.0 * c1 * f1, (c1 - nu) * gn
+                    br, bi = ar - mus * ai, ai + mus * ar
+                    f3, f4 = bi * sn - br * co, -(br * sn) - bi * co
+                f5 = ft * (wr + c1)
+                if i == n:
+                    break
+                m0, c0 = c0, m0 + h2 * c1
+                m1, c1 = c1, m1 + h2 * f1
+                m2, c2 = c2, m2 + h2 * gn
+                m3, c3 = c3, m3 + h2 * f3
+                m4, c4 = c4, m4 + h2 * f4
+                m5, c5 = c5, m5 + h2 * f5
+            return [
+                0.5 * (c0 + m0 + h * c1),
+                0.5 * (c1 + m1 + h * f1),
+                0.5 * (c2 + m2 + h * gn),
+                0.5 * (c3 + m3 + h * f3),
+                0.5 * (c4 + m4 + h * f4),
+                0.5 * (c5 + m5 + h * f5),
+            ]
+        except (ValueError, OverflowError):
+            return [math.nan] * 6
 
     def force(self, u: float, theta: float, dtheta: float) -> complex:
         """Contact force per m c_r (1/s^2, inertial) at local time u in state (theta, theta')."""
@@ -298,8 +303,11 @@ class Sliding:
             return gn, 1.0
         return gn, self.s * (self.wf.wr + y[1])
 
-    def run(self, rem: float, H0: float) -> tuple[SegmentEnd, float]:
-        """Integrate up to ``rem`` seconds or the first event; return (end, next step size)."""
+    def run(self, rem: float, H0: float, limit: int = WORK_MAX) -> tuple[SegmentEnd, float]:
+        """Integrate up to ``rem`` seconds or the first event; return (end, next step size).
+
+        Raises ContactWorkExceeded, saying where it stopped, before an integrator step
+        once the segment has used more than ``limit`` work units (right-hand sides)."""
         y = [self.theta0, self.dtheta0, 0.0, 0.0, 0.0, 0.0]
         u = 0.0
         H = min(H0, self.h_max)
@@ -308,9 +316,14 @@ class Sliding:
         rates = (self.force_tol, tol_j, tol_j, self.force_tol * (abs(self.wf.wr) + self.w))
         tally = ContactTally()
         tally.peak = max(0.0, self.events(y, 0.0)[0])
-        for _ in range(MAX_STEPS + int(min(50.0 * rem / self.h_max, 1e9))):
-            if u >= rem:
-                break
+        n_steps = 0
+        while u < rem:
+            if tally.work > limit:
+                raise ContactWorkExceeded(
+                    f"sliding stopped at {u!r} s of its {rem!r} s segment after {n_steps} "
+                    f"integrator steps (step size {H!r} s, theta = {y[0]!r} rad, "
+                    f"theta' = {y[1]!r} rad/s)", tally.work)
+            n_steps += 1
             step = min(H, rem - u)
             cut = step < H  # cut short by the segment's end: accept from any column
             f0 = self.rhs(u, y)
@@ -318,7 +331,7 @@ class Sliding:
             y_new, err, k, nfev = gbs.extrapolated_step(
                 self.sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN
             )
-            tally.work += nfev
+            tally.work += nfev + GBS_STEP_WORK
             if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
                 H = gbs.next_step_size(step, err, k) if err == err else 0.1 * step
                 continue
@@ -332,8 +345,6 @@ class Sliding:
             u, y = u_next, y_new
             if not cut:  # a cut step says nothing about the step the motion allows
                 H = min(gbs.next_step_size(step, err, k), self.h_max)
-        else:
-            raise ContactWorkExceeded("sliding segment exceeded its step cap", tally.work)
         self._tally(tally, y, rem)
         return SegmentEnd(rem, y[0], y[1], None, tally), H
 
@@ -382,7 +393,7 @@ class Sliding:
             yx, _, _, nfev = gbs.extrapolated_step(
                 self.sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4)
             )
-            tally.work += nfev
+            tally.work += nfev + GBS_STEP_WORK
             gn, sv = self.events(yx, u + x)
             return yx, min(gn / s_n, sv / s_v)
 

@@ -58,19 +58,39 @@ slack G4 tau/4 grows with the interval, so a longer one only shortens the safe s
 MAX_ADVANCES = 400
 """Advances in one search call (a grazing pass needs ~40); a flight creeping along the
 wall for long may need more, and the caller then resumes from where the search stopped."""
+WORK_MAX = 1_600_000
+"""Work bound of one communication step, in work units (``Work``; docs/model.md 7): a
+step, with all of its spin sub-steps, that would need more stops with STATUS_WORK_CAP.
+Every loop of the core counts into one counter; it is checked before each segment, at
+each advance of the contact search and at each step of the sliding integrator."""
+WORK_OVERSHOOT = 14_100
+"""Most work units a step can use beyond WORK_MAX: what runs between two checks of the
+bound. The largest such piece is one event location of the sliding integrator (at most
+142 re-integrations of at most 98 units each, contact.Sliding._locate) with its step."""
+SEGMENT_WORK = 8
+"""Work units charged for each segment of a step's event loop (a flight to the next event,
+an impact, a contact segment, a mode change): its fixed cost besides the loops it runs
+(a new search with its modes, the impact law, the contact models, a flight map), so that
+no kind of segment costs more time per unit than a search advance (docs/model.md 7)."""
+FLIGHT_MAP_WORK = 6
+"""Work units of a point of the search from the divided-difference flight map (when the
+modes are ill conditioned): it computes the map's coefficients, the time of about 6 search
+advances (measured)."""
 
 
 @dataclass
 class Work:
-    """Deterministic work counter: closed-form evaluations and root-finder iterations."""
+    """Deterministic work counter: closed-form evaluations, root-finder and integrator
+    iterations, and the segments of a step's event loop (SEGMENT_WORK each)."""
 
     evals: int = 0
     iters: int = 0
+    segs: int = 0  # SEGMENT_WORK per segment of the step's event loop
 
     @property
     def total(self) -> int:
-        """evals + iters."""
-        return self.evals + self.iters
+        """evals + iters + segs."""
+        return self.evals + self.iters + self.segs
 
 
 @dataclass(frozen=True)
@@ -279,6 +299,7 @@ class ContactLocator:
         if modes is not None:
             z, v, rot = modes.at(s)
             return z, v, self.E0 * rot
+        work.evals += FLIGHT_MAP_WORK - 1
         z, v = self.fm.propagate(self.z0, self.v0, self.E0, s)
         return z, v, self.E0 * cmath.exp(1j * self.fm.Omega * s)
 
@@ -321,8 +342,13 @@ class ContactLocator:
         tol_g2 = 256.0 * EPS * (abs(v) ** 2 + fm.c_r * force) + G2_FLOOR
         return tol_g1, tol_g2
 
-    def find(self, h: float, on_wall: bool, work: Work) -> Contact | None:
+    def find(self, h: float, on_wall: bool, work: Work, limit: int = MAX_ADVANCES
+             ) -> Contact | None:
         """First contact in (0, h], or None. ``on_wall``: the start lies on the circle.
+
+        At most min(limit, MAX_ADVANCES) advances (at least one), each of which costs at
+        least one work unit; then it returns a "clear" contact where it stopped. The caller
+        passes the work left in its step, so a search never runs past the step's bound.
 
         Each advance bounds g over tau = min(remaining, horizon) by the cubic with the
         exact g''' plus g3_slack, and steps to the bound's first root, or by tau if it
@@ -349,7 +375,7 @@ class ContactLocator:
         neg_rescale = -_NO_RESCALE
         exp = cmath.exp
         modal = 0  # 1: points by Modes.at (inline), -1: by self.state, 0: not decided yet
-        for _ in range(MAX_ADVANCES):
+        for _ in range(MAX_ADVANCES if limit >= MAX_ADVANCES else max(limit, 1)):
             acc = -beta * v - kappa * z + f0 + F1 * E
             zc = z.conjugate()
             g = (z * zc).real - c2

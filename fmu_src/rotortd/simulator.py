@@ -49,7 +49,7 @@ from .contact import (
     rub_deviation,
     wrap_angle,
 )
-from .events import ContactLocator, Work, flight_is_clear
+from .events import SEGMENT_WORK, WORK_MAX, ContactLocator, Work, flight_is_clear
 from .flight import FlightModel
 from .impact import Impact, reset
 from .limits import CrossParameterError, start_position
@@ -75,9 +75,6 @@ RUB_RETRY = 4.0
 linearised rub and the lock are tried again, when a stable forward rub exists. Without it
 a long step integrated all of its sliding, however close to the rub it came (a 10 s step
 at the rub cost 0.19 s CPU)."""
-WORK_BASE = 20_000
-WORK_PER_RADIAN = 100_000
-"""Work cap of one step: WORK_BASE + WORK_PER_RADIAN * h * w_max (see work_cap)."""
 _R_CLEAR = 1.0 - 1e-9
 _TWO_PI_HI, _TWO_PI_LO = 6.283185307179586, 2.4492935982947064e-16
 
@@ -151,34 +148,14 @@ class _Tally:
         self.peak = max(self.peak, mc * tal.peak)
 
 
-def work_cap(
-    p: RotorParams, h: float, Omega: float, F_ext: complex, amb: float, speed: float = 0.0
-) -> int:
-    """Documented cap on the work counter of one step of length h (s).
-
-    WORK_BASE + WORK_PER_RADIAN * h * w_max, where w_max (rad/s) is the largest rate in
-    the scene: |Omega|, R|Omega|/c_r (rolling whirl), sqrt(k/m), c/m, the rate
-    sqrt(F/(m c_r)) at which the largest force moves the rotor across the clearance, and
-    the rate speed/c_r of the rotor's own speed (m/s) at the start of the step.
-    """
-    return _cap(h, _input_rate(p, Omega, F_ext, amb), speed / p.c_r)
+def work_cap(*_args: object) -> int:
+    """The work bound of one step (units): the constant WORK_MAX, whatever the scene and
+    the step length (docs/model.md 7). The arguments (parameters, h, Omega, F_ext, amb_on,
+    speed, as the former rate-based cap took them) are accepted and ignored."""
+    return WORK_MAX
 
 
-def _input_rate(p: RotorParams, Omega: float, F_ext: complex, amb: float) -> float:
-    """The part of work_cap's w_max (rad/s) fixed by the parameters and held inputs."""
-    force = abs(F_ext) + p.m * p.g + amb * p.m * p.g * p.levitate + p.m * p.e_c * Omega**2
-    return max(
-        abs(Omega),
-        p.R * abs(Omega) / p.c_r,
-        math.sqrt(amb * p.k / p.m),
-        amb * p.c / p.m,
-        math.sqrt(force / (p.m * p.c_r)),
-    )
-
-
-def _cap(h: float, w_inputs: float, w_speed: float) -> int:
-    x = h * (w_inputs if w_inputs > w_speed else w_speed)  # radians of the fastest rate
-    return int(WORK_BASE + WORK_PER_RADIAN * (x if x < 1e12 else 1e12))
+_SEGMENT_NAMES = {MODE_FREE: "free flight", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
 
 
 class TouchdownCore:
@@ -227,7 +204,7 @@ class TouchdownCore:
         self._t_contact = math.nan
         self._H = math.inf
         self._inputs: tuple[float, complex, float] = (0.0, 0j, 1.0)
-        self._w_inputs = 0.0  # _input_rate of the held inputs (rad/s)
+        self._cap = WORK_MAX  # in a step: its work bound (units)
         self._fm: FlightModel | None = None
         self._wf: WallForces | None = None
 
@@ -374,8 +351,13 @@ class TouchdownCore:
         rot = cmath.exp(-1j * psi)
         zr = z * rot
         r = abs(z)
-        whirl = (z.real * v.imag - z.imag * v.real) / (r * r) if r > 0.0 else 0.0
-        dU = (v - 1j * W * z) * rot / (c_r * W) if W != 0.0 else 0j
+        rr = r * r
+        whirl = (z.real * v.imag - z.imag * v.real) / rr if rr > 0.0 else (
+            ((z.real * v.imag - z.imag * v.real) / r) / r if r > 0.0 else 0.0)
+        den = c_r * W
+        dU = (v - 1j * W * z) * rot / den if den != 0.0 else 0j
+        if not (math.isfinite(dU.real) and math.isfinite(dU.imag)):
+            dU = 0j  # |Omega| so small that dU/dt overflows: the Omega = 0 convention
         F_amb = a * (p.bias_force - p.c * v - p.k * z)
         return (
             z.real, z.imag, v.real, v.imag, r / c_r, zr.real / c_r, zr.imag / c_r,
@@ -385,8 +367,13 @@ class TouchdownCore:
 
     # ------------------------------------------------------------------ stepping
 
-    def step(self, h: float, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0) -> StepReport:
-        """Advance by h seconds with Omega (rad/s), F_ext (N) and amb_on held."""
+    def step(self, h: float, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0,
+             budget: int | None = None) -> StepReport:
+        """Advance by h seconds with Omega (rad/s), F_ext (N) and amb_on held.
+
+        The step's work is bounded by ``budget`` work units (default and at most WORK_MAX;
+        SpinCoupler passes what its sub-steps have left). A step that would need more stops
+        where it is with STATUS_WORK_CAP and a message saying where (docs/model.md 7)."""
         F = complex(F_ext)
         if not (0.0 < h < math.inf and math.isfinite(Omega) and 0.0 <= amb_on <= 1.0
                 and math.isfinite(F.real) and math.isfinite(F.imag)):
@@ -394,7 +381,7 @@ class TouchdownCore:
         W, a = float(Omega), float(amb_on)
         if (W, F, a) != self._inputs or self._fm is None:
             self._set_inputs(W, F, a)
-        cap = _cap(h, self._w_inputs, abs(self._v) / self._p.c_r)
+        cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
         refused = False
         if self._mode == MODE_FREE:
             quick = self._proved_free_step(h, cap)
@@ -412,11 +399,13 @@ class TouchdownCore:
         self._s_lo = 0.0
         self._rub_refused = refused
         rep = StepReport(work_cap=cap)
+        self._cap = cap
         t0, s = self._t, 0.0
         try:
             while s < h:
                 if work.total > cap:
-                    raise WorkCapExceeded(f"step work exceeded its cap {cap}")
+                    raise WorkCapExceeded("before the next segment")
+                work.segs += SEGMENT_WORK
                 mode, s_before = self._mode, s
                 s = self._advance(s, h, t0, tally, work)
                 if self._mode != mode:
@@ -424,8 +413,12 @@ class TouchdownCore:
                     if s == s_before and MODE_FREE in (mode, self._mode):
                         self._sticky_at = s  # N = 0 to rounding: contact holds past it
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
-            rep.status, rep.message = STATUS_WORK_CAP, f"t = {t0 + s!r} s: {exc}"
             work.iters += getattr(exc, "work", 0)
+            rep.status, rep.message = STATUS_WORK_CAP, (
+                f"work bound reached: {work.total} > {cap} work units; the core stopped at "
+                f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
+                f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
+                f"{len(tally.impacts)} impacts in the step): {exc}")
         self._tick(h if s >= h else s)
         self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
         return rep
@@ -475,7 +468,6 @@ class TouchdownCore:
     def _set_inputs(self, W: float, F: complex, a: float) -> None:
         """New held inputs (or parameters): rebuild the flight and wall models."""
         self._inputs = (W, F, a)
-        self._w_inputs = _input_rate(self._p, W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
@@ -535,7 +527,7 @@ class TouchdownCore:
         hit = loc = None
         if not self._clear:
             loc = ContactLocator(fm, self._z, self._v, E)
-            hit = loc.find(rem, self._on_wall, work)
+            hit = loc.find(rem, self._on_wall, work, self._cap - work.total)
         if hit is None:
             if loc is not None and s > 0.0:
                 # the rest of a step after an event: a length that will not recur, whose
@@ -691,6 +683,7 @@ class TouchdownCore:
             end, self._H = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack).run(
                 self._slide_span(rem),
                 self._H if math.isfinite(self._H) else 0.05 / wf.omega_ref(self._dtheta),
+                self._cap - work.total,
             )
         work.iters += end.tally.work
         self._end_segment(end, tally)

@@ -9,6 +9,13 @@ applies the exact angular impulse the core reports for it:
 
 so the angular momentum balance is exact (to round-off) and the coupling error is that of
 holding Omega over ``h_spin`` instead of over the communication step. SI units.
+
+Work bound (docs/model.md 7): the sub-steps of one communication step share the core's
+per-step bound WORK_MAX. Each sub-step costs its core work plus SUBSTEP_WORK units (the
+fixed cost of a core call whose inputs changed); the core gets what is left as its budget.
+A step that needs more sub-steps than the bound allows is refused before any is taken, and
+one whose sub-steps use up the bound stops after the last one that fit; either way with
+STATUS_WORK_CAP and a message saying where.
 """
 
 from __future__ import annotations
@@ -18,13 +25,21 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 STATUS_OK = 0
+STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP
+WORK_MAX = 1_600_000
+"""Work bound of one communication step (units), the core's rotortd.WORK_MAX (a test
+checks that they agree; this package does not import the core)."""
+SUBSTEP_WORK = 20
+"""Work units charged per sub-step on top of the core's own count: a core call whose
+spin changed rebuilds its flight and wall models (about 20 units of the core's slowest
+work per unit, measured; docs/model.md 7)."""
 
 
 class _Core(Protocol):
     t: float
 
     def step(self, h: float, Omega: float, F_ext: complex = 0j,
-             amb_on: float = 1.0) -> Any: ...
+             amb_on: float = 1.0, budget: int | None = None) -> Any: ...
 
 
 @dataclass
@@ -45,6 +60,8 @@ class SpinReport:
     transitions: list[Any] = field(default_factory=list)
     Omega_end: float = 0.0     # rad/s
     n_sub: int = 0             # sub-steps taken
+    work: int = 0              # work units: the core's plus SUBSTEP_WORK per sub-step
+    work_cap: int = WORK_MAX   # the bound on work
 
 
 class SpinCoupler:
@@ -65,19 +82,38 @@ class SpinCoupler:
 
     def step(self, core: _Core, h: float, T_drive: float, F_ext: complex = 0j,
              amb_on: float = 1.0) -> SpinReport:
-        """Advance core and spin by h [s] with T_drive [N m], F_ext [N], amb_on held."""
-        n = self.n_sub(h)
-        hs = h / n
+        """Advance core and spin by h [s] with T_drive [N m], F_ext [N], amb_on held,
+        within the work bound WORK_MAX (module docstring)."""
         out = SpinReport()
         t_start = core.t
+        per_sub = SUBSTEP_WORK + 1  # the least a sub-step costs
+        if not h / self.h_spin * (1.0 - 1e-12) <= WORK_MAX // per_sub:  # (also NaN, inf)
+            out.status, out.message = STATUS_WORK_CAP, (
+                f"work bound reached: the step of {h!r} s needs {h / self.h_spin:.6g} "
+                f"sub-steps of h_spin = {self.h_spin!r} s, more than the "
+                f"{WORK_MAX // per_sub} that the bound of {WORK_MAX} work units allows "
+                f"({per_sub} each at least); refused at t = {t_start!r} s, nothing taken")
+            out.mode = getattr(core, "mode", 0)
+            out.Omega_end = self.Omega
+            return out
+        n = self.n_sub(h)
+        hs = h / n
         for i in range(n):
-            rep = core.step(hs, self.Omega, F_ext=F_ext, amb_on=amb_on)
+            left = WORK_MAX - out.work - SUBSTEP_WORK
+            if left <= 0:
+                out.status, out.message = STATUS_WORK_CAP, (
+                    f"work bound reached: {out.work} of {WORK_MAX} work units used by "
+                    f"{i} of {n} sub-steps of {hs!r} s; stopped at t = {core.t!r} s")
+                break
+            rep = core.step(hs, self.Omega, F_ext=F_ext, amb_on=amb_on, budget=left)
+            out.work += rep.work + SUBSTEP_WORK
             _accumulate(out, rep, hs)
             self.Omega += (T_drive + rep.T_f) * hs / self.J
             out.n_sub = i + 1
             if rep.status != STATUS_OK:
                 out.status, out.message = rep.status, rep.message
-                if rep.status == 1:        # work cap: stop where the core stopped
+                if rep.status == STATUS_WORK_CAP:  # stop where the core stopped
+                    out.message = f"sub-step {i + 1} of {n} ({hs!r} s each): {rep.message}"
                     break
         span = max(core.t - t_start, 0.0) or h
         _average(out, span)

@@ -1,0 +1,142 @@
+"""The per-step work bound (docs/model.md 7): every step ends within WORK_MAX work units
+(plus at most one sliding event location, WORK_OVERSHOOT) for any finite input, and stops
+with STATUS_WORK_CAP and a message saying where when the bound is reached; the spin
+sub-steps of one communication step share the bound. Extremes that are slow but correct
+(a 1e12 N force) finish within it, and a tiny spin speed behaves like Omega = 0."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from rotortd import STATUS_OK, STATUS_WORK_CAP, WORK_MAX, RotorParams, TouchdownCore
+from rotortd.events import WORK_OVERSHOOT
+from rotortd_drive import spin
+
+BASE = RotorParams()  # the FMU's defaults: m = 50 kg, c_r = 0.7 mm, Omega = 184.2 rad/s
+W0 = 184.2
+
+
+def _assert_capped(rep: object, core: TouchdownCore, t0: float, h: float, cap: int) -> None:
+    assert rep.status == STATUS_WORK_CAP
+    assert "work bound reached" in rep.message and "t = " in rep.message
+    assert cap < rep.work <= cap + WORK_OVERSHOOT
+    assert t0 <= core.t < t0 + h
+    assert all(math.isfinite(x) for x in (core.z.real, core.z.imag)) or "free" in rep.message
+
+
+def test_long_step_with_fast_impacts_stops_at_the_bound() -> None:
+    """A 10 s step of a rotor thrown around by a large imbalance with d = 1 (tens of
+    thousands of impacts per ms): the cap fires at the real bound; the state is the one
+    at the time reported, and the next step goes on from there."""
+    p = BASE.replace(e_c=0.1, c=0.0, k=0.0, d=1.0, mu=0.0, c_r=1e-6, m=1e-3)
+    core = TouchdownCore(p, 0j, 1.0 + 0j)
+    rep = core.step(10.0, 1e5)
+    _assert_capped(rep, core, 0.0, 10.0, WORK_MAX)
+    assert "free flight" in rep.message and "impacts in the step" in rep.message
+    assert rep.work_cap == WORK_MAX and len(rep.impacts) > 1000
+    assert abs(core.z) <= p.c_r * (1.0 + 1e-12)
+    t1 = core.t
+    rep2 = core.step(1e-9, 1e5)
+    assert rep2.status == STATUS_OK and core.t == pytest.approx(t1 + 1e-9, abs=1e-15)
+
+
+def test_sliding_segment_stops_inside_at_its_budget() -> None:
+    """The 1e12 N scene with a small budget: the sliding integrator stops inside its
+    segment and says where (the budget argument is the one SpinCoupler passes)."""
+    core = TouchdownCore(BASE)
+    F = 1e12 + 0j
+    assert core.step(1e-4, W0, F).status == STATUS_OK  # impacts, then sliding
+    t0 = core.t
+    rep = core.step(1e-4, W0, F, budget=2000)
+    _assert_capped(rep, core, t0, 1e-4, 2000)
+    assert "in sliding" in rep.message and "sliding stopped at" in rep.message
+
+
+@pytest.mark.parametrize("case", ["vx0 = 1e308", "F_x = -1.7e308 mid-run"])
+def test_overflowing_extremes_stop_at_the_bound(case: str) -> None:
+    """Finite inputs beyond the FMU's ranges whose flight overflows (NaN states): the
+    search cannot make progress, and the step stops at its budget instead of hanging."""
+    if case == "vx0 = 1e308":
+        core, F = TouchdownCore(BASE, 0j, 1e308 + 0j), 0j
+    else:
+        core, F = TouchdownCore(BASE), -1.7e308 + 0j
+        assert core.step(1e-3, W0).status == STATUS_OK
+    t0 = core.t
+    rep = core.step(1e-3, W0, F, budget=50_000)
+    _assert_capped(rep, core, t0, 1e-3, 50_000)
+
+
+@pytest.mark.parametrize("h_spin", [1e-300, 1e-8])
+def test_spin_step_needing_too_many_sub_steps_is_refused_at_once(h_spin: float) -> None:
+    """h/h_spin sub-steps beyond what the bound allows: refused before any is taken."""
+    core = TouchdownCore(BASE)
+    sc = spin.SpinCoupler(0.04, h_spin, W0)
+    rep = sc.step(core, 10.0, 1.0)
+    assert rep.status == STATUS_WORK_CAP and rep.n_sub == 0 and rep.work == 0
+    assert "sub-steps of h_spin" in rep.message and "nothing taken" in rep.message
+    assert core.t == 0.0 and sc.Omega == W0
+
+
+def test_spin_sub_steps_share_the_bound() -> None:
+    """Sub-steps that fit in number but not in work (in contact, the spin changes every
+    sub-step): the coupler stops after the sub-step that reaches the bound."""
+    core = TouchdownCore(BASE.replace(c=0.0, k=0.0, mu=0.3), BASE.c_r + 0j, 0.5j)
+    sc = spin.SpinCoupler(0.04, 1e-8, W0)
+    n = spin.WORK_MAX // (spin.SUBSTEP_WORK + 1)  # the most sub-steps the bound allows
+    rep = sc.step(core, n * 1e-8, 0.0)
+    assert rep.status == STATUS_WORK_CAP and 0 < rep.n_sub < n
+    assert "sub-step" in rep.message and "work bound reached" in rep.message
+    assert WORK_MAX - 1000 < rep.work <= WORK_MAX + WORK_OVERSHOOT  # (stops when the next
+    assert core.t < n * 1e-8  # sub-step's SUBSTEP_WORK would not fit, or inside one)
+
+
+def test_spin_bound_is_the_core_bound() -> None:
+    assert spin.WORK_MAX == WORK_MAX
+    assert spin.STATUS_WORK_CAP == STATUS_WORK_CAP
+
+
+def test_force_of_1e12_newton_stays_within_the_bound() -> None:
+    """F_x = 1e12 N presses the rotor into the bearing (default parameters, 1e-4 s steps):
+    a stiff, lightly damped friction pendulum at sqrt(F/(m c_r)) = 5.3e6 rad/s that the
+    sliding integrator follows at about 0.5 rad per step, some 45,000 units per step.
+    Every step ends OK, well within the bound (the full 200 steps: the slow group)."""
+    core = TouchdownCore(BASE)
+    for _ in range(10):
+        rep = core.step(1e-4, W0, 1e12 + 0j)
+        assert rep.status == STATUS_OK and rep.work <= WORK_MAX // 10
+        assert abs(core.z) <= BASE.c_r * (1.0 + 1e-12)
+
+
+@pytest.mark.slow
+def test_force_of_1e12_newton_for_200_steps() -> None:
+    core = TouchdownCore(BASE)
+    works = []
+    for _ in range(200):
+        rep = core.step(1e-4, W0, 1e12 + 0j)
+        assert rep.status == STATUS_OK
+        works.append(rep.work)
+    assert max(works) <= WORK_MAX // 10
+    assert core.t == pytest.approx(0.02, abs=1e-15)
+
+
+@pytest.mark.parametrize("W", [5e-324, -5e-324, 1e-310, 1e-300])
+def test_tiny_spin_speed_behaves_like_zero(W: float) -> None:
+    """A subnormal or tiny Omega: steps in free flight, impacts and contact end OK, and the
+    kinematics are finite; the scaled dU/dt, where it would overflow (or divide by
+    c_r Omega = 0), is 0 as at Omega = 0."""
+    for z0, v0 in ((0j, 0j), (0.5e-3 + 0j, 0.1 + 0.2j), (BASE.c_r + 0j, 0.05j)):
+        core = TouchdownCore(BASE.replace(k=0.0, c=0.0) if z0 == 0 else BASE, z0, v0)
+        for i in range(20):
+            rep = core.step(1e-3 if i % 2 else 3.7e-3, W, 1e3 + 0j if i > 10 else 0j)
+            assert rep.status == STATUS_OK
+            kin = core.kinematics(W, 1.0)
+            assert all(math.isfinite(x) for x in kin)
+        if BASE.c_r * abs(W) < abs(core.v) / 1.7e308:  # dU/dt = ~v/(c_r Omega) overflows
+            assert kin.du_re == 0.0 and kin.du_im == 0.0
+    zero = TouchdownCore(BASE, 0.5e-3 + 0j, 0.1 + 0.2j).kinematics(0.0, 1.0)
+    assert zero.du_re == 0.0 and zero.du_im == 0.0
+    sc = spin.SpinCoupler(0.04, 1e-4, W)
+    core = TouchdownCore(BASE, BASE.c_r + 0j, 0.05j)
+    rep = sc.step(core, 1e-3, 0.0)
+    assert rep.status == STATUS_OK and math.isfinite(sc.Omega)
