@@ -22,6 +22,8 @@ from typing import Any
 from pythonfmu import DefaultExperiment, Fmi2Slave, Real
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
+from .exit_order import register_exit_order
+
 VARIABLE_META: dict[str, tuple[str, float | None, float | None]] = {
     "t_fail": ("s", None, None),
     "amb_before": ("1", 0.0, 1.0),
@@ -64,6 +66,7 @@ class TouchdownEventsAdapter(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        register_exit_order(self.resources)  # issue 18, see guard.GuardedSlave.__init__
         for name, start, desc in PARAMETERS:
             setattr(self, name, start)
             self.register_variable(Real(name, causality=Fmi2Causality.parameter,

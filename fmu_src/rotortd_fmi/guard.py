@@ -8,14 +8,26 @@ logged with ``Fmi2Status.error``, the call returns False (fmi2Discard), and ever
 
 from __future__ import annotations
 
+from typing import Any
+
 from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
+
+from .exit_order import register_exit_order
 
 
 class GuardedSlave(Fmi2Slave):
     """Fmi2Slave whose initialisation and steps report errors instead of raising them."""
 
     _failure = ""  # non-empty: the model is unusable and do_step refuses
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        # Issue 18: PythonFMU 0.7.0's binary frees its `pyState` (PySlaveInstance.cpp:667)
+        # from a static destructor at exit and then releases it again in onLibraryUnload
+        # (:722-725 -> :695), a use-after-free that sometimes aborts the host after a clean
+        # run. exit_order releases it first, at exit, so both later calls do nothing.
+        register_exit_order(self.resources)
 
     def exit_initialization_mode(self) -> bool:
         try:
