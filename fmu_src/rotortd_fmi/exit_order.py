@@ -23,7 +23,9 @@ a ``lock xadd`` on its use count, 8 bytes into the freed chunk. Valgrind reports
 "Invalid read of size 4 at finalizePythonInterpreter ... 8 bytes inside a block of size 128
 free'd by __run_exit_handlers", on every run. If the chunk sits in a glibc bin with its own
 header, those bytes are its ``bk`` link, and the next unlink aborts with "corrupted
-double-linked list". The heap layout at exit decides that, hence roughly 1 run in 100.
+double-linked list". The heap layout at exit decides that, so the abort is rare and
+machine-dependent (issue 18 saw 3 of about 330 runs; 0 of 2300 runs on the machine where the
+cause was found), while valgrind reports the invalid access on every run.
 
 This module avoids the path from our side. For the loaded binary of this FMU, it registers
 that binary's exported ``finalizePythonInterpreter`` as an exit handler with ``__cxa_atexit``.
