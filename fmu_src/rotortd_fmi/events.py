@@ -22,6 +22,7 @@ from typing import Any
 from pythonfmu import DefaultExperiment, Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
+from .exit_order import register_exit_order
 from .variables import OUTPUT, PARAMETER, Var, meta, output, register
 
 TIME_EPS = 1e-9  # s: host clocks that add h repeatedly may land just before an event time
@@ -58,6 +59,7 @@ class TouchdownEventsAdapter(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        register_exit_order(self.resources)  # issue 18, see guard.GuardedSlave.__init__
         self._t_now = 0.0   # the outputs are the schedule at this time [s]
         register(self, TABLE, lambda _name: None, self._refuse,
                  getters={v.name: self._getter(v.name) for v in TABLE if v.causality == OUTPUT})

@@ -14,9 +14,12 @@ is refused (FMI allows only fmi2FreeInstance or fmi2Reset then).
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
+
+from .exit_order import register_exit_order
 
 
 class GuardedSlave(Fmi2Slave):
@@ -27,6 +30,14 @@ class GuardedSlave(Fmi2Slave):
 
     def terminate(self) -> None:
         self._terminated = True
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        # Issue 18: PythonFMU 0.7.0's binary frees its `pyState` (PySlaveInstance.cpp:667)
+        # from a static destructor at exit and then releases it again in onLibraryUnload
+        # (:722-725 -> :695), a use-after-free that sometimes aborts the host after a clean
+        # run. exit_order releases it first, at exit, so both later calls do nothing.
+        register_exit_order(self.resources)
 
     def exit_initialization_mode(self) -> bool:
         try:
