@@ -224,7 +224,7 @@ def test_spin_reversal_while_sliding_keeps_the_whirl() -> None:
                                           (-5.0e5j, 0.0, 1.0)])
 def test_fused_sliding_sweep_is_the_generic_midpoint_rule(q0: complex, mu: float,
                                                           slip: float) -> None:
-    """Sliding.sweep is a fused copy of gbs.midpoint on Sliding.rhs: bit-identical, so the
+    """Sliding.midpoint_sweep is a fused copy of gbs.midpoint on Sliding.rhs: bit-identical, so the
     sliding integrator is the documented modified-midpoint extrapolation, only faster."""
     wf = WallForces(q0=q0, eu=2.1e5 * cmath.exp(0.7j), beta=36.8, kappa=3.4e4,
                     Omega=W0, wr=1.2e3, mu=mu)
@@ -235,7 +235,8 @@ def test_fused_sliding_sweep_is_the_generic_midpoint_rule(q0: complex, mu: float
         f0 = sl.rhs(0.37, y0)
         for n in gbs.SEQUENCE:
             for H in (1e-6, 3e-4, 2e-3):
-                assert sl.sweep(0.37, y0, f0, H, n) == gbs.midpoint(sl.rhs, 0.37, y0, f0, H, n)
+                fused = sl.midpoint_sweep(0.37, y0, f0, H, n)
+                assert fused == gbs.midpoint(sl.rhs, 0.37, y0, f0, H, n)
 
 
 def test_extrapolation_error_ratio_is_nan_when_any_component_is() -> None:

@@ -34,6 +34,7 @@ from . import gbs
 from .divdiff import dd2
 from .events import G2_FLOOR, WORK_MAX
 from .params import RotorParams
+from .scaled import wrap_angle
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""
@@ -63,14 +64,6 @@ class ContactWorkExceeded(RuntimeError):
     def __init__(self, message: str, work: int = 0) -> None:
         super().__init__(message)
         self.work = work
-
-
-def wrap_angle(x: float) -> float:
-    """Reduce an angle (rad) to [-pi, pi) with a two-part 2 pi (no drift over long runs)."""
-    k = math.floor((x + math.pi) / (2.0 * math.pi))
-    if k == 0:
-        return x
-    return (x - k * 6.283185307179586) - k * 2.4492935982947064e-16
 
 
 def phase_integral(nu: float, x: float) -> complex:
@@ -169,9 +162,10 @@ class ContactTally:
 
 @dataclass
 class SegmentEnd:
-    """Where a contact segment stopped: after ``du`` seconds, state, and the event."""
+    """Where a contact segment stopped: after ``duration`` seconds, state, and the event."""
 
-    du: float
+    duration: float
+    """Length of the segment (s), from its start to its end or event."""
     theta: float
     dtheta: float
     event: str | None  # None (end), "lift_off", "slip_zero", "slip_stuck", "cone"
@@ -238,7 +232,8 @@ class Sliding:
             jx, jy = bi * sn - br * co, -(br * sn) - bi * co
         return [dth, ddth, gn, jx, jy, ft * (wf.wr + dth)]
 
-    def sweep(self, u0: float, y0: list[float], f0: list[float], H: float, n: int) -> list[float]:
+    def midpoint_sweep(self, u0: float, y0: list[float], f0: list[float], H: float,
+                       n: int) -> list[float]:
         """gbs.midpoint(self.rhs, u0, y0, f0, H, n), fused: the same floating-point
         operations (bit-identical, checked by a test) on scalars instead of lists, which
         halves the cost of the sliding integrator. u0, H in s; y as in ``rhs``."""
@@ -329,7 +324,7 @@ class Sliding:
             f0 = self.rhs(u, y)
             scale = self._step_scale(rates, step, y)
             y_new, err, k, nfev = gbs.extrapolated_step(
-                self.sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN
+                self.midpoint_sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN
             )
             tally.work += nfev + GBS_STEP_WORK
             if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
@@ -391,7 +386,7 @@ class Sliding:
 
         def at(x: float) -> tuple[list[float], float]:
             yx, _, _, nfev = gbs.extrapolated_step(
-                self.sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4)
+                self.midpoint_sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4)
             )
             tally.work += nfev + GBS_STEP_WORK
             gn, sv = self.events(yx, u + x)

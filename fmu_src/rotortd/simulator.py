@@ -47,13 +47,13 @@ from .contact import (
     forward_rub_equilibria,
     phase_integral,
     rub_deviation,
-    wrap_angle,
 )
 from .events import SEGMENT_WORK, WORK_MAX, ContactLocator, Work, flight_is_clear
 from .flight import FlightModel
 from .impact import Impact, reset
 from .limits import CrossParameterError, start_position
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
+from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 
 MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
 STATUS_OK, STATUS_WORK_CAP = 0, 1
@@ -76,7 +76,6 @@ linearised rub and the lock are tried again, when a stable forward rub exists. W
 a long step integrated all of its sliding, however close to the rub it came (a 10 s step
 at the rub cost 0.19 s CPU)."""
 _R_CLEAR = 1.0 - 1e-9
-_TWO_PI_HI, _TWO_PI_LO = 6.283185307179586, 2.4492935982947064e-16
 
 
 class WorkCapExceeded(RuntimeError):
@@ -185,14 +184,14 @@ class TouchdownCore:
         self._t_lo = 0.0  # compensation of the clock (Kahan), s
         self._z, self._v = z0, v0
         self._psi, self._turns = wrap_angle(float(psi0)), 0
-        self._turns = round((float(psi0) - self._psi) / _TWO_PI_HI)
+        self._turns = round((float(psi0) - self._psi) / TWO_PI_HI)
         self._mode = MODE_FREE
         self._theta = 0.0
         self._dtheta = 0.0
         self._slip = 0.0
         self._locked = False
         self._on_wall = abs(z0) >= params.c_r * (1.0 - 1e-15)
-        self._unclear()
+        self._forget_clear_proof()
         self._roll_lenient = False  # in a step: zero slip proved stuck (_transition)
         self._sticky_at = math.nan  # in a step: where flight and contact swapped at N = 0
         self._rub_refused = False  # in a step: its start state is not near a rub (_rub_step)
@@ -202,7 +201,7 @@ class TouchdownCore:
         self._v_last = 0.0
         self._E_diss = 0.0
         self._t_contact = math.nan
-        self._H = math.inf
+        self._slide_step = math.inf
         self._inputs: tuple[float, complex, float] = (0.0, 0j, 1.0)
         self._cap = WORK_MAX  # in a step: its work bound (units)
         self._fm: FlightModel | None = None
@@ -224,9 +223,7 @@ class TouchdownCore:
         W = check_finite("Omega", Omega)
         if W == 0.0:
             raise ParameterError("Omega = 0.0 rad/s: a scaled initial state needs Omega != 0")
-        rot = cmath.exp(1j * psi0)
-        z0 = params.c_r * complex(U0) * rot
-        v0 = params.c_r * (W * complex(dU0) + 1j * W * complex(U0)) * rot
+        z0, v0 = to_inertial(U0, dU0, W, params.c_r, psi0)
         return cls(params, z0, v0, psi0, t0)
 
     @classmethod
@@ -279,7 +276,7 @@ class TouchdownCore:
         self._p = params
         self._fm = None
         self._wf = None
-        self._unclear()
+        self._forget_clear_proof()
         self._locked = False
 
     @property
@@ -300,7 +297,7 @@ class TouchdownCore:
     @property
     def psi(self) -> float:
         """Spin angle (rad), unwrapped."""
-        return self._turns * _TWO_PI_HI + (self._psi + self._turns * _TWO_PI_LO)
+        return self._turns * TWO_PI_HI + (self._psi + self._turns * TWO_PI_LO)
 
     @property
     def mode(self) -> int:
@@ -419,7 +416,7 @@ class TouchdownCore:
                 f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
                 f"{len(tally.impacts)} impacts in the step): {exc}")
-        self._tick(h if s >= h else s)
+        self._advance_clock(h if s >= h else s)
         self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
         return rep
 
@@ -446,7 +443,7 @@ class TouchdownCore:
         self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
         self._advance_psi(h)
         self._on_wall = False
-        self._tick(h)
+        self._advance_clock(h)
         return StepReport(work=work, work_cap=cap)
 
     @staticmethod
@@ -458,7 +455,7 @@ class TouchdownCore:
         check_finite("F_y", F.imag, InputError)
         check_range("amb_on", amb_on, 0.0, 1.0, error=InputError)
 
-    def _tick(self, dt: float) -> None:
+    def _advance_clock(self, dt: float) -> None:
         """Advance the clock by dt with compensated summation (no drift over 1e6 steps)."""
         y = dt - self._t_lo
         t = self._t + y
@@ -471,7 +468,7 @@ class TouchdownCore:
         self._fm = FlightModel(self._p, W, F, a)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
-        self._unclear()
+        self._forget_clear_proof()
         self._locked = False
 
     def _fill_report(self, rep: StepReport, tal: _Tally, work: Work, h: float) -> None:
@@ -510,9 +507,9 @@ class TouchdownCore:
 
     def _advance_psi(self, ds: float) -> None:
         x = self._psi + self._inputs[0] * ds
-        k = math.floor((x + math.pi) / _TWO_PI_HI)
+        k = math.floor((x + math.pi) / TWO_PI_HI)
         if k:
-            x = (x - k * _TWO_PI_HI) - k * _TWO_PI_LO
+            x = (x - k * TWO_PI_HI) - k * TWO_PI_LO
             self._turns += k
         self._psi = x
 
@@ -546,7 +543,7 @@ class TouchdownCore:
             self._on_wall = False
             return self._later(s, ds)
         z = hit.z * (self._p.c_r / abs(hit.z))
-        self._unclear()
+        self._forget_clear_proof()
         if hit.kind == "impact":
             self._impact(t0 + s + (self._s_lo + ds), z, hit.v, tally)
         else:
@@ -571,7 +568,7 @@ class TouchdownCore:
         else:
             self._envelope_at = math.inf
 
-    def _unclear(self) -> None:
+    def _forget_clear_proof(self) -> None:
         """Forget the envelope proof: the state jumped or the inputs changed."""
         self._clear = False
         self._envelope_at = -math.inf
@@ -680,21 +677,23 @@ class TouchdownCore:
             end = Rolling(wf, self._theta, E).run(rem, cone_slack=slack)
         elif (end := self._rub_segment(rem, E, self._may_linearise(s, sticky))) is None:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
-            end, self._H = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack).run(
+            H0 = self._slide_step
+            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack)
+            end, self._slide_step = seg.run(
                 self._slide_span(rem),
-                self._H if math.isfinite(self._H) else 0.05 / wf.omega_ref(self._dtheta),
+                H0 if math.isfinite(H0) else 0.05 / wf.omega_ref(self._dtheta),
                 self._cap - work.total,
             )
         work.iters += end.tally.work
         self._end_segment(end, tally)
-        return self._later(s, end.du) if end.du < rem else h
+        return self._later(s, end.duration) if end.duration < rem else h
 
     def _end_segment(self, end: SegmentEnd, tally: _Tally) -> None:
         """Take the state, contact integrals and event at the end of a contact segment."""
         p = self._p
         tally.add_contact(end.tally, p.m * p.c_r, p.c_r)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
-        self._advance_psi(end.du)
+        self._advance_psi(end.duration)
         self._transition(end.event)
         self._sync_from_contact()
 
@@ -711,7 +710,7 @@ class TouchdownCore:
             return None
         tally = _Tally()
         self._end_segment(end, tally)
-        self._tick(h)
+        self._advance_clock(h)
         rep = StepReport(work_cap=cap)
         self._fill_report(rep, tally, Work(iters=end.tally.work), h)
         return rep
@@ -756,7 +755,7 @@ class TouchdownCore:
         self._mode = MODE_FREE
         self._on_wall = True
         self._locked = False
-        self._unclear()
+        self._forget_clear_proof()
 
     def _lock(self, lin: LinearRub | QuadraticRub, rem: float, E: complex) -> SegmentEnd:
         """Put the state on the rub of ``lin`` (lock it) and rotate rigidly for rem s."""
@@ -857,7 +856,7 @@ class TouchdownCore:
             "v_last": self._v_last,
             "E_diss": self._E_diss,
             "t_contact": None if math.isnan(self._t_contact) else self._t_contact,
-            "H": None if math.isinf(self._H) else self._H,
+            "H": None if math.isinf(self._slide_step) else self._slide_step,
             "inputs": [
                 self._inputs[0],
                 self._inputs[1].real,
@@ -889,4 +888,4 @@ class TouchdownCore:
         self._t_last, self._v_last = float(st["t_last"]), float(st["v_last"])
         self._E_diss = float(st["E_diss"])
         self._t_contact = math.nan if st["t_contact"] is None else float(st["t_contact"])
-        self._H = math.inf if st["H"] is None else float(st["H"])
+        self._slide_step = math.inf if st["H"] is None else float(st["H"])
