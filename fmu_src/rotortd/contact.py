@@ -162,7 +162,11 @@ class ContactTally:
 
 @dataclass
 class SegmentEnd:
-    """Where a contact segment stopped: after ``duration`` seconds, state, and the event."""
+    """Where a contact segment stopped: after ``duration`` seconds, state, and the event.
+
+    Every contact segment (Sliding, Rolling, LinearRub, QuadraticRub, LockedRub) returns
+    one from ``run(rem, limit)``: advance at most ``rem`` seconds, at most ``limit`` work
+    units, and stop at the first event."""
 
     duration: float
     """Length of the segment (s), from its start to its end or event."""
@@ -170,6 +174,8 @@ class SegmentEnd:
     dtheta: float
     event: str | None  # None (end), "lift_off", "slip_zero", "slip_stuck", "cone"
     tally: ContactTally = field(default_factory=ContactTally)
+    next_step: float = math.inf
+    """Sliding only: the integrator's step size (s) for the next sliding segment."""
 
 
 # --------------------------------------------------------------------------- sliding
@@ -186,8 +192,10 @@ class Sliding:
         E0: complex,
         s: float,
         gn_slack: float = 0.0,
+        step0: float = math.inf,
     ) -> None:
         self.wf = wf
+        self.step0 = step0  # first integrator step (s); inf: 0.05/w
         self.gn_slack = gn_slack  # lift-off only once Gn < -gn_slack (1/s^2)
         self.s = s
         self.mus = wf.mu * s
@@ -298,14 +306,16 @@ class Sliding:
             return gn, 1.0
         return gn, self.s * (self.wf.wr + y[1])
 
-    def run(self, rem: float, H0: float, limit: int = WORK_MAX) -> tuple[SegmentEnd, float]:
-        """Integrate up to ``rem`` seconds or the first event; return (end, next step size).
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
+        """Integrate up to ``rem`` seconds or the first event; the end carries the next
+        step size (``SegmentEnd.next_step``).
 
         Raises ContactWorkExceeded, saying where it stopped, before an integrator step
         once the segment has used more than ``limit`` work units (right-hand sides)."""
         y = [self.theta0, self.dtheta0, 0.0, 0.0, 0.0, 0.0]
         u = 0.0
-        H = min(H0, self.h_max)
+        H0 = self.step0
+        H = min(H0 if math.isfinite(H0) else 0.05 / self.w, self.h_max)
         self.nu = self.dtheta0 if abs(self.dtheta0) * rem >= NU_MIN else 0.0
         tol_j = self.force_tol * (abs(self.nu) if self.nu else 1.0)  # I_c's error = J's / nu
         rates = (self.force_tol, tol_j, tol_j, self.force_tol * (abs(self.wf.wr) + self.w))
@@ -334,14 +344,14 @@ class Sliding:
             if gn <= 0.0 or sv <= 0.0:
                 x, y_ev, kind = self._locate(u, y, f0, step, k, tally)
                 self._tally(tally, y_ev, u + x)
-                return SegmentEnd(u + x, y_ev[0], y_ev[1], kind, tally), H
+                return SegmentEnd(u + x, y_ev[0], y_ev[1], kind, tally, H)
             tally.peak = max(tally.peak, gn)
             u_next = u + step if step < rem - u else rem
             u, y = u_next, y_new
             if not cut:  # a cut step says nothing about the step the motion allows
                 H = min(gbs.next_step_size(step, err, k), self.h_max)
         self._tally(tally, y, rem)
-        return SegmentEnd(rem, y[0], y[1], None, tally), H
+        return SegmentEnd(rem, y[0], y[1], None, tally, H)
 
     def _step_scale(self, rates: tuple[float, ...], step: float, y: list[float]) -> list[float]:
         """Error scales of one step: theta and theta' as in __init__; each quadrature
@@ -494,8 +504,12 @@ class TrigSum:
 class Rolling:
     """Rolling (v_rel = 0) from theta0 with phasor E0: closed form (see module docstring)."""
 
-    def __init__(self, wf: WallForces, theta0: float, E0: complex) -> None:
+    def __init__(self, wf: WallForces, theta0: float, E0: complex,
+                 cone_slack: float = 0.0) -> None:
         self.wf = wf
+        self.cone_slack = cone_slack
+        """(1/s^2) > 0 ignores cone violations smaller than it: used after a sliding attempt
+        proved unable to leave zero slip (a violation below resolution)."""
         self.theta0 = theta0
         self.E0 = E0
         self.dtheta = -wf.wr
@@ -525,12 +539,10 @@ class Rolling:
         X = self.A1 * cmath.exp(1j * self.nu1 * u) + self.A2 * cmath.exp(1j * self.nu2 * u)
         return self.C + X.real, self.Gt0 + X.imag
 
-    def run(self, rem: float, cone_slack: float = 0.0) -> SegmentEnd:
-        """Roll up to ``rem`` seconds or until the first exit (lift-off or friction cone).
-
-        ``cone_slack`` (1/s^2) > 0 ignores cone violations smaller than it: used after a
-        sliding attempt proved unable to leave zero slip (a violation below resolution).
-        """
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
+        """Roll up to ``rem`` seconds or until the first exit (lift-off or friction cone);
+        its work is bounded by MAX_ROOT_ITERS per exit, whatever ``limit``."""
+        cone_slack = self.cone_slack
         tally = ContactTally()
         names = ("lift_off", "cone", "cone")
         # an exit happens once its function is past the rounding band that the mode
@@ -767,8 +779,9 @@ class LinearRub(_RubStep):
         x0, y0 = self.x0, self.y0
         return x0 * (c + sig * sh) + y0 * sh, y0 * (c - sig * sh) - a1 * x0 * sh
 
-    def run(self, rem: float) -> SegmentEnd:
-        """Advance rem seconds: the end state and the contact integrals (ContactTally)."""
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
+        """Advance rem seconds: the end state and the contact integrals (ContactTally).
+        One closed-form evaluation (work 1), whatever ``limit``."""
         wf, eq, mus = self.wf, self.eq, self.mus
         W, a1, b1 = wf.Omega, eq.a1, eq.b1
         x0, y0 = self.x0, self.y0
@@ -870,8 +883,9 @@ class QuadraticRub(_RubStep):
         """Never locked from here (LinearRub takes over closer to the rub)."""
         return math.inf
 
-    def run(self, rem: float) -> SegmentEnd:
-        """Advance rem seconds: the end state and the contact integrals (ContactTally)."""
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
+        """Advance rem seconds: the end state and the contact integrals (ContactTally).
+        One closed-form evaluation (work 1), whatever ``limit``."""
         wf, eq = self.wf, self.eq
         W, a1, b1, mus = wf.Omega, eq.a1, eq.b1, self.mus
         x0, y0 = self.x0, self.y0
@@ -909,6 +923,31 @@ class QuadraticRub(_RubStep):
                             gx * x + gy * y + gxx * q[0] + q[2])
         tal.work = 1
         return SegmentEnd(rem, self.theta0 + W * rem + (x - x0), W + y, None, tal)
+
+
+class LockedRub:
+    """Sliding exactly on a forward rub: a rigid rotation theta' = Omega with Gn constant,
+    in closed form (``TouchdownCore`` locks a state within LOCK_TOL of the rub onto it)."""
+
+    __slots__ = ("E0", "dtheta0", "slip", "theta0", "wf")
+
+    def __init__(self, wf: WallForces, theta0: float, dtheta0: float, E0: complex,
+                 slip: float) -> None:
+        self.wf, self.theta0, self.dtheta0, self.E0, self.slip = wf, theta0, dtheta0, E0, slip
+
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
+        """Rotate rem seconds (work 1, whatever ``limit``)."""
+        wf, theta, dtheta = self.wf, self.theta0, self.dtheta0
+        gn, _ = wf.gn_gt(theta, dtheta, self.E0)
+        ft = wf.mu * self.slip * gn
+        tal = ContactTally()
+        tal.I_n = gn * rem
+        tal.I_t = ft * rem
+        tal.I_c = -complex(gn, ft) * cmath.exp(1j * theta) * phase_integral(wf.Omega, rem)
+        tal.I_e = ft * (wf.wr + dtheta) * rem
+        tal.peak = gn
+        tal.work = 1
+        return SegmentEnd(rem, theta + wf.Omega * rem, dtheta, None, tal)
 
 
 def _quadratic_drop(wf: WallForces, eq: RubEquilibrium, mus: float, X: float, Y: float,

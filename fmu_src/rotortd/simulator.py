@@ -38,6 +38,7 @@ from .contact import (
     ContactTally,
     ContactWorkExceeded,
     LinearRub,
+    LockedRub,
     QuadraticRub,
     Rolling,
     RubEquilibrium,
@@ -45,7 +46,6 @@ from .contact import (
     Sliding,
     WallForces,
     forward_rub_equilibria,
-    phase_integral,
     rub_deviation,
 )
 from .events import SEGMENT_WORK, WORK_MAX, ContactLocator, Work, flight_is_clear
@@ -674,16 +674,12 @@ class TouchdownCore:
             return s
         if self._mode == MODE_ROLLING:
             slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if self._roll_lenient else 0.0
-            end = Rolling(wf, self._theta, E).run(rem, cone_slack=slack)
+            end = Rolling(wf, self._theta, E, slack).run(rem)
         elif (end := self._rub_segment(rem, E, self._may_linearise(s, sticky))) is None:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
-            H0 = self._slide_step
-            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack)
-            end, self._slide_step = seg.run(
-                self._slide_span(rem),
-                H0 if math.isfinite(H0) else 0.05 / wf.omega_ref(self._dtheta),
-                self._cap - work.total,
-            )
+            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step)
+            end = seg.run(self._slide_span(rem), self._cap - work.total)
+            self._slide_step = end.next_step
         work.iters += end.tally.work
         self._end_segment(end, tally)
         return self._later(s, end.duration) if end.duration < rem else h
@@ -762,7 +758,7 @@ class TouchdownCore:
         self._theta = wrap_angle(lin.eq.alpha + cmath.phase(E))
         self._dtheta = lin.wf.Omega
         self._locked = True
-        return self._locked_rotation(rem, E)
+        return LockedRub(lin.wf, self._theta, self._dtheta, E, self._slip).run(rem)
 
     def _rub_equilibria(self) -> list[RubEquilibrium]:
         """forward_rub_equilibria of the held inputs (computed once per inputs)."""
@@ -776,7 +772,8 @@ class TouchdownCore:
         rigid rotation when locked; else, if ``linearise``, the linearised motion when the
         state admits it (locking first when the snap is below LOCK_TOL); else None."""
         if self._locked:
-            return self._locked_rotation(rem, E)
+            assert self._wf is not None
+            return LockedRub(self._wf, self._theta, self._dtheta, E, self._slip).run(rem)
         lin = self._linear_rub(E) if linearise else None
         if lin is None:
             return None
@@ -814,21 +811,6 @@ class TouchdownCore:
             if lin is not None:
                 return lin
         return None
-
-    def _locked_rotation(self, rem: float, E: complex) -> SegmentEnd:
-        """Closed-form synchronous rub over rem seconds (theta' = Omega, Gn constant)."""
-        wf = self._wf
-        assert wf is not None
-        gn, _ = wf.gn_gt(self._theta, self._dtheta, E)
-        ft = wf.mu * self._slip * gn
-        tal = ContactTally()
-        tal.I_n = gn * rem
-        tal.I_t = ft * rem
-        tal.I_c = -complex(gn, ft) * cmath.exp(1j * self._theta) * phase_integral(wf.Omega, rem)
-        tal.I_e = ft * (wf.wr + self._dtheta) * rem
-        tal.peak = gn
-        tal.work = 1
-        return SegmentEnd(rem, self._theta + wf.Omega * rem, self._dtheta, None, tal)
 
     # ------------------------------------------------------------------ state (de)serialisation
 
