@@ -127,10 +127,15 @@ class Kinematics(NamedTuple):
     F_amb_y: float
 
 
-class _Tally:
-    """Impulses and contact integrals accumulated over one step (SI)."""
+class _Step:
+    """One step's context, passed down the step loop and never stored on the core: the
+    impulses and contact integrals it accumulates (SI), its work and work bound, and the
+    flags that live for one step only."""
 
-    def __init__(self) -> None:
+    __slots__ = ("E", "P_n", "P_t", "P_vec", "cap", "impacts", "peak", "roll_lenient",
+                 "rub_refused", "s_lo", "sticky_at", "transitions", "work")
+
+    def __init__(self, cap: int, rub_refused: bool = False) -> None:
         self.impacts: list[Impact] = []
         self.P_vec = 0j  # N s, on the rotor
         self.P_n = 0.0  # N s
@@ -138,13 +143,28 @@ class _Tally:
         self.E = 0.0  # J
         self.peak = 0.0  # N
         self.transitions: list[tuple[float, str]] = []  # (t, kind)
+        self.work = Work()
+        self.cap = cap  # work bound (units)
+        self.s_lo = 0.0  # rounding error of the step-local time (later), s
+        self.roll_lenient = False  # zero slip proved stuck (_transition)
+        self.sticky_at = math.nan  # where flight and contact swapped at N = 0
+        self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
 
     def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
+        """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
         self.P_vec += mc * tal.I_c
         self.P_n += mc * tal.I_n
         self.P_t += mc * tal.I_t
         self.E += mc * c_r * tal.I_e
         self.peak = max(self.peak, mc * tal.peak)
+
+    def later(self, s: float, ds: float) -> float:
+        """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step
+        of many events would otherwise drift by one rounding per event."""
+        t = s + ds
+        r = t - s
+        self.s_lo += (s - (t - r)) + (ds - r)
+        return t
 
 
 def work_cap(*_args: object) -> int:
@@ -192,10 +212,6 @@ class TouchdownCore:
         self._locked = False
         self._on_wall = abs(z0) >= params.c_r * (1.0 - 1e-15)
         self._forget_clear_proof()
-        self._roll_lenient = False  # in a step: zero slip proved stuck (_transition)
-        self._sticky_at = math.nan  # in a step: where flight and contact swapped at N = 0
-        self._rub_refused = False  # in a step: its start state is not near a rub (_rub_step)
-        self._s_lo = 0.0  # in a step: rounding error of the step-local time (_later), s
         self._n_impacts = 0
         self._t_last = 0.0
         self._v_last = 0.0
@@ -203,7 +219,6 @@ class TouchdownCore:
         self._t_contact = math.nan
         self._slide_step = math.inf
         self._inputs: tuple[float, complex, float] = (0.0, 0j, 1.0)
-        self._cap = WORK_MAX  # in a step: its work bound (units)
         self._fm: FlightModel | None = None
         self._wf: WallForces | None = None
 
@@ -389,14 +404,9 @@ class TouchdownCore:
             if quick is not None:
                 return quick
             refused = True  # this state is not near a rub: the loop need not ask again
-        tally = _Tally()
-        work = Work()
-        self._roll_lenient = False
-        self._sticky_at = math.nan
-        self._s_lo = 0.0
-        self._rub_refused = refused
+        st = _Step(cap, refused)
+        work = st.work
         rep = StepReport(work_cap=cap)
-        self._cap = cap
         t0, s = self._t, 0.0
         try:
             while s < h:
@@ -404,20 +414,20 @@ class TouchdownCore:
                     raise WorkCapExceeded("before the next segment")
                 work.segs += SEGMENT_WORK
                 mode, s_before = self._mode, s
-                s = self._advance(s, h, t0, tally, work)
+                s = self._advance(s, h, t0, st)
                 if self._mode != mode:
-                    tally.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
+                    st.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
                     if s == s_before and MODE_FREE in (mode, self._mode):
-                        self._sticky_at = s  # N = 0 to rounding: contact holds past it
+                        st.sticky_at = s  # N = 0 to rounding: contact holds past it
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
             work.iters += getattr(exc, "work", 0)
             rep.status, rep.message = STATUS_WORK_CAP, (
                 f"work bound reached: {work.total} > {cap} work units; the core stopped at "
                 f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
-                f"{len(tally.impacts)} impacts in the step): {exc}")
+                f"{len(st.impacts)} impacts in the step): {exc}")
         self._advance_clock(h if s >= h else s)
-        self._fill_report(rep, tally, work, self._t - t0 if s < h else h)
+        self._fill_report(rep, st, self._t - t0 if s < h else h)
         return rep
 
     def _proved_free_step(self, h: float, cap: int) -> StepReport | None:
@@ -471,7 +481,7 @@ class TouchdownCore:
         self._forget_clear_proof()
         self._locked = False
 
-    def _fill_report(self, rep: StepReport, tal: _Tally, work: Work, h: float) -> None:
+    def _fill_report(self, rep: StepReport, tal: _Step, h: float) -> None:
         inv = 1.0 / h if h > 0.0 else 0.0
         rep.impacts = tal.impacts
         rep.F_contact = tal.P_vec * inv
@@ -483,24 +493,16 @@ class TouchdownCore:
         rep.T_f = -self._p.R * tal.P_t * inv
         rep.E_diss = tal.E
         rep.mode = self._mode
-        rep.work = work.total
+        rep.work = tal.work.total
         rep.transitions = tal.transitions
         self._E_diss += tal.E
 
-    def _advance(self, s: float, h: float, t0: float, tally: _Tally, work: Work) -> float:
+    def _advance(self, s: float, h: float, t0: float, st: _Step) -> float:
         if self._mode == MODE_FREE:
-            return self._advance_free(s, h, t0, tally, work)
-        return self._advance_contact(s, h, tally, work)
+            return self._advance_free(s, h, t0, st)
+        return self._advance_contact(s, h, st)
 
     # ------------------------------------------------------------------ free flight
-
-    def _later(self, s: float, ds: float) -> float:
-        """Step-local time s + ds (s), its rounding error kept in _s_lo (2Sum): a long step
-        of many events would otherwise drift by one rounding per event."""
-        t = s + ds
-        r = t - s
-        self._s_lo += (s - (t - r)) + (ds - r)
-        return t
 
     def _phasor(self) -> complex:
         return cmath.exp(1j * self._psi)
@@ -513,10 +515,11 @@ class TouchdownCore:
             self._turns += k
         self._psi = x
 
-    def _advance_free(self, s: float, h: float, t0: float, tally: _Tally, work: Work) -> float:
+    def _advance_free(self, s: float, h: float, t0: float, st: _Step) -> float:
         fm = self._fm
         assert fm is not None
-        rem = (h - s) - self._s_lo
+        work = st.work
+        rem = (h - s) - st.s_lo
         E = self._phasor()
         if not self._clear and not self._on_wall and t0 + s >= self._envelope_at:
             work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
@@ -524,7 +527,7 @@ class TouchdownCore:
         hit = loc = None
         if not self._clear:
             loc = ContactLocator(fm, self._z, self._v, E)
-            hit = loc.find(rem, self._on_wall, work, self._cap - work.total)
+            hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
         if hit is None:
             if loc is not None and s > 0.0:
                 # the rest of a step after an event: a length that will not recur, whose
@@ -541,15 +544,15 @@ class TouchdownCore:
         if hit.kind == "clear":
             self._z, self._v = hit.z, hit.v
             self._on_wall = False
-            return self._later(s, ds)
+            return st.later(s, ds)
         z = hit.z * (self._p.c_r / abs(hit.z))
         self._forget_clear_proof()
         if hit.kind == "impact":
-            self._impact(t0 + s + (self._s_lo + ds), z, hit.v, tally)
+            self._impact(t0 + s + (st.s_lo + ds), z, hit.v, st)
         else:
             self._z, self._v = z, hit.v
             self._enter_contact()
-        return self._later(s, ds)
+        return st.later(s, ds)
 
     def _check_envelope(self, fm: FlightModel, t: float, E: complex) -> None:
         """Try to prove the flight clear of the wall for all time under the held inputs
@@ -573,7 +576,7 @@ class TouchdownCore:
         self._clear = False
         self._envelope_at = -math.inf
 
-    def _impact(self, t: float, z: complex, v_minus: complex, tally: _Tally) -> None:
+    def _impact(self, t: float, z: complex, v_minus: complex, tally: _Step) -> None:
         p = self._p
         W = self._inputs[0]
         n = z / p.c_r
@@ -658,39 +661,39 @@ class TouchdownCore:
         self._z = self._p.c_r * e
         self._v = 1j * self._p.c_r * self._dtheta * e
 
-    def _advance_contact(self, s: float, h: float, tally: _Tally, work: Work) -> float:
+    def _advance_contact(self, s: float, h: float, st: _Step) -> float:
         wf = self._wf
         assert wf is not None
-        rem = (h - s) - self._s_lo
+        rem = (h - s) - st.s_lo
         E = self._phasor()
         vrel = wf.wr + self._dtheta
         if (self._mode == MODE_ROLLING and vrel != 0.0) or (
             self._mode == MODE_SLIDING and vrel * self._slip <= 0.0 and wf.mu != 0.0
         ):
             self._choose_contact_mode()  # the host changed Omega: the slip follows v_rel
-        sticky = s == self._sticky_at
+        sticky = s == st.sticky_at
         if not sticky and self._leaves_wall(E):
             self._lift_off()
             return s
         if self._mode == MODE_ROLLING:
-            slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if self._roll_lenient else 0.0
+            slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if st.roll_lenient else 0.0
             end = Rolling(wf, self._theta, E, slack).run(rem)
-        elif (end := self._rub_segment(rem, E, self._may_linearise(s, sticky))) is None:
+        elif (end := self._rub_segment(rem, E, self._may_linearise(s, sticky, st))) is None:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
             seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step)
-            end = seg.run(self._slide_span(rem), self._cap - work.total)
+            end = seg.run(self._slide_span(rem), st.cap - st.work.total)
             self._slide_step = end.next_step
-        work.iters += end.tally.work
-        self._end_segment(end, tally)
-        return self._later(s, end.duration) if end.duration < rem else h
+        st.work.iters += end.tally.work
+        self._end_segment(end, st)
+        return st.later(s, end.duration) if end.duration < rem else h
 
-    def _end_segment(self, end: SegmentEnd, tally: _Tally) -> None:
+    def _end_segment(self, end: SegmentEnd, tally: _Step) -> None:
         """Take the state, contact integrals and event at the end of a contact segment."""
         p = self._p
         tally.add_contact(end.tally, p.m * p.c_r, p.c_r)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_psi(end.duration)
-        self._transition(end.event)
+        self._transition(end.event, tally)
         self._sync_from_contact()
 
     def _rub_step(self, h: float, cap: int) -> StepReport | None:
@@ -704,11 +707,12 @@ class TouchdownCore:
         end = self._rub_segment(h, self._phasor(), True)
         if end is None:
             return None
-        tally = _Tally()
-        self._end_segment(end, tally)
+        st = _Step(cap)
+        st.work.iters = end.tally.work
+        self._end_segment(end, st)
         self._advance_clock(h)
         rep = StepReport(work_cap=cap)
-        self._fill_report(rep, tally, Work(iters=end.tally.work), h)
+        self._fill_report(rep, st, h)
         return rep
 
     def _leaves_wall(self, E: complex) -> bool:
@@ -726,7 +730,7 @@ class TouchdownCore:
         dd = 0.0 if self._mode == MODE_ROLLING else gt - wf.mu * self._slip * gn
         return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0
 
-    def _transition(self, event: str | None) -> None:
+    def _transition(self, event: str | None, st: _Step) -> None:
         wf = self._wf
         assert wf is not None
         if event is None:
@@ -741,7 +745,7 @@ class TouchdownCore:
             self._dtheta = -wf.wr  # cone violations below resolution are ignored this step
             self._mode = MODE_ROLLING
             self._locked = False
-            self._roll_lenient = True
+            st.roll_lenient = True
         elif event == "cone":
             _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
@@ -788,10 +792,10 @@ class TouchdownCore:
             return min(rem, RUB_RETRY / wf.omega_ref(self._dtheta))
         return rem
 
-    def _may_linearise(self, s: float, sticky: bool) -> bool:
+    def _may_linearise(self, s: float, sticky: bool, st: _Step) -> bool:
         """May a sliding segment starting s seconds into the step try the linearised rub?
         Not when sticky, nor at the step's start when _rub_step has refused that state."""
-        refused, self._rub_refused = self._rub_refused and s == 0.0, False
+        refused, st.rub_refused = st.rub_refused and s == 0.0, False
         return not (sticky or refused)
 
     def _linear_rub(self, E: complex) -> LinearRub | QuadraticRub | None:
