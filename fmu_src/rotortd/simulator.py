@@ -84,7 +84,12 @@ class WorkCapExceeded(RuntimeError):
 
 @dataclass(slots=True)
 class StepReport:
-    """What happened in one step (SI, inertial). Forces are step averages (impulse/h)."""
+    """What happened in one step (SI, inertial). Forces are step averages (impulse/h).
+
+    Also the step's accumulator: while the step runs, impacts and contact segments add
+    their impulses to P_contact, P_n, P_t, E_diss and F_n_peak (the contact force's peak;
+    the impacts' P_n/h join it at the end), and the step's end turns the impulses into the
+    averages F_contact, F_n and T_f (``TouchdownCore._finish``)."""
 
     status: int = STATUS_OK
     message: str = ""
@@ -100,6 +105,18 @@ class StepReport:
     work_cap: int = 0
     transitions: list[tuple[float, str]] = field(default_factory=list)
     """Mode changes in the step: (t, "sliding" | "rolling" | "lift_off")."""
+    P_contact: complex = 0j
+    """Impulse of the contact on the rotor over the step (N s): F_contact = P_contact/h."""
+    P_t: float = 0.0
+    """Signed friction impulse (N s): T_f = -R P_t/h."""
+
+    def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
+        """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
+        self.P_contact += mc * tal.I_c
+        self.P_n += mc * tal.I_n
+        self.P_t += mc * tal.I_t
+        self.E_diss += mc * c_r * tal.I_e
+        self.F_n_peak = max(self.F_n_peak, mc * tal.peak)
 
 
 class Kinematics(NamedTuple):
@@ -128,35 +145,19 @@ class Kinematics(NamedTuple):
 
 
 class _Step:
-    """One step's context, passed down the step loop and never stored on the core: the
-    impulses and contact integrals it accumulates (SI), its work and work bound, and the
-    flags that live for one step only."""
+    """The context of a step taken segment by segment, passed down the step loop and
+    never stored on the core: its work and work bound, the rounding error of its local
+    time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
 
-    __slots__ = ("E", "P_n", "P_t", "P_vec", "cap", "impacts", "peak", "roll_lenient",
-                 "rub_refused", "s_lo", "sticky_at", "transitions", "work")
+    __slots__ = ("cap", "roll_lenient", "rub_refused", "s_lo", "sticky_at", "work")
 
     def __init__(self, cap: int, rub_refused: bool = False) -> None:
-        self.impacts: list[Impact] = []
-        self.P_vec = 0j  # N s, on the rotor
-        self.P_n = 0.0  # N s
-        self.P_t = 0.0  # N s, signed friction impulse (torque impulse = -R P_t)
-        self.E = 0.0  # J
-        self.peak = 0.0  # N
-        self.transitions: list[tuple[float, str]] = []  # (t, kind)
         self.work = Work()
         self.cap = cap  # work bound (units)
         self.s_lo = 0.0  # rounding error of the step-local time (later), s
         self.roll_lenient = False  # zero slip proved stuck (_transition)
         self.sticky_at = math.nan  # where flight and contact swapped at N = 0
         self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
-
-    def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
-        """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
-        self.P_vec += mc * tal.I_c
-        self.P_n += mc * tal.I_n
-        self.P_t += mc * tal.I_t
-        self.E += mc * c_r * tal.I_e
-        self.peak = max(self.peak, mc * tal.peak)
 
     def later(self, s: float, ds: float) -> float:
         """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step
@@ -175,6 +176,7 @@ def work_cap(*_args: object) -> int:
 
 
 _SEGMENT_NAMES = {MODE_FREE: "free flight", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
+_PROVED_FREE, _RUB = "proved free flight", "rub in closed form"  # _whole_step's choices
 
 
 class TouchdownCore:
@@ -394,29 +396,39 @@ class TouchdownCore:
         if (W, F, a) != self._inputs or self._fm is None:
             self._set_inputs(W, F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
-        refused = False
-        if self._mode == MODE_FREE:
-            quick = self._proved_free_step(h, cap)
-            if quick is not None:
-                return quick
-        elif self._mode == MODE_SLIDING:
-            quick = self._rub_step(h, cap)
-            if quick is not None:
-                return quick
-            refused = True  # this state is not near a rub: the loop need not ask again
-        st = _Step(cap, refused)
-        work = st.work
         rep = StepReport(work_cap=cap)
-        t0, s = self._t, 0.0
+        t0, s = self._t, h
+        whole = self._whole_step(h, rep)  # choose: the whole step in one closed form?
+        if whole is None:  # else segment by segment, each chosen where the last ended
+            s = self._segments(h, t0, rep, _Step(cap, self._mode == MODE_SLIDING))
+        self._finish(rep, t0, s, h, whole is not _PROVED_FREE)
+        return rep
+
+    def _whole_step(self, h: float, rep: StepReport) -> str | None:
+        """The step's first choice: a whole step in one closed form, advanced and tallied
+        into ``rep``: _PROVED_FREE (a flight proved clear of the wall, nothing to tally) or
+        _RUB (a rub in closed form); None when the state admits neither (the step is
+        taken segment by segment; a sliding state refused here is not asked again)."""
+        if self._mode == MODE_FREE:
+            return _PROVED_FREE if self._proved_free_step(h, rep) else None
+        if self._mode == MODE_SLIDING:
+            return _RUB if self._rub_step(h, rep) else None
+        return None
+
+    def _segments(self, h: float, t0: float, rep: StepReport, st: _Step) -> float:
+        """The step loop: choose the next segment from the state, advance it, apply its
+        end (``_advance``), until the step is done or its work bound is reached. Returns
+        how far (s) into the step it got."""
+        work, cap, s = st.work, st.cap, 0.0
         try:
             while s < h:
                 if work.total > cap:
                     raise WorkCapExceeded("before the next segment")
                 work.segs += SEGMENT_WORK
                 mode, s_before = self._mode, s
-                s = self._advance(s, h, t0, st)
+                s = self._advance(s, h, t0, rep, st)
                 if self._mode != mode:
-                    st.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
+                    rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
                     if s == s_before and MODE_FREE in (mode, self._mode):
                         st.sticky_at = s  # N = 0 to rounding: contact holds past it
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
@@ -425,36 +437,43 @@ class TouchdownCore:
                 f"work bound reached: {work.total} > {cap} work units; the core stopped at "
                 f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
-                f"{len(st.impacts)} impacts in the step): {exc}")
-        self._advance_clock(h if s >= h else s)
-        self._fill_report(rep, st, self._t - t0 if s < h else h)
-        return rep
+                f"{len(rep.impacts)} impacts in the step): {exc}")
+        rep.work = work.total
+        return s
 
-    def _proved_free_step(self, h: float, cap: int) -> StepReport | None:
+    def _finish(self, rep: StepReport, t0: float, s: float, h: float, tallied: bool) -> None:
+        """The one place a step ends: advance the clock to where the step got (s of h) and
+        turn the report's impulses into step averages (not after a flight proved free,
+        whose report holds nothing to average)."""
+        self._advance_clock(h if s >= h else s)
+        if tallied:
+            self._fill_report(rep, self._t - t0 if s < h else h)
+
+    def _proved_free_step(self, h: float, rep: StepReport) -> bool:
         """A free step proved contact-free without a search: by the envelope for all time
         under the held inputs (``_clear``), or by the cubic bound of ``flight_is_clear`` over
         the whole step. Then one closed-form propagation, nothing to tally; else None (the
         caller searches). Either way the step ends in the same state as a search that finds
-        nothing, which also propagates once from the start."""
+        nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
         assert fm is not None
         E = self._phasor()
         work = 1
         if not self._clear:
             if self._on_wall:
-                return None
+                return False
             if self._t >= self._envelope_at:
                 work += 1
                 self._check_envelope(fm, self._t, E)
             if not self._clear:
                 work += 1
                 if not flight_is_clear(fm, self._z, self._v, E, h):
-                    return None
+                    return False
         self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
         self._advance_psi(h)
         self._on_wall = False
-        self._advance_clock(h)
-        return StepReport(work=work, work_cap=cap)
+        rep.work = work
+        return True
 
     @staticmethod
     def _reject_inputs(h: float, Omega: float, F: complex, amb_on: float) -> None:
@@ -481,26 +500,22 @@ class TouchdownCore:
         self._forget_clear_proof()
         self._locked = False
 
-    def _fill_report(self, rep: StepReport, tal: _Step, h: float) -> None:
+    def _fill_report(self, rep: StepReport, h: float) -> None:
+        """Averages over h (s) of the impulses the step added to ``rep``; the mode."""
         inv = 1.0 / h if h > 0.0 else 0.0
-        rep.impacts = tal.impacts
-        rep.F_contact = tal.P_vec * inv
-        rep.F_n = tal.P_n * inv
-        rep.P_n = tal.P_n
-        rep.F_n_peak = tal.peak
-        for imp in tal.impacts:
+        rep.F_contact = rep.P_contact * inv
+        rep.F_n = rep.P_n * inv
+        for imp in rep.impacts:
             rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
-        rep.T_f = -self._p.R * tal.P_t * inv
-        rep.E_diss = tal.E
+        rep.T_f = -self._p.R * rep.P_t * inv
         rep.mode = self._mode
-        rep.work = tal.work.total
-        rep.transitions = tal.transitions
-        self._E_diss += tal.E
+        self._E_diss += rep.E_diss
 
-    def _advance(self, s: float, h: float, t0: float, st: _Step) -> float:
+    def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: _Step) -> float:
+        """One segment from s seconds into the step: flight or contact, by the mode."""
         if self._mode == MODE_FREE:
-            return self._advance_free(s, h, t0, st)
-        return self._advance_contact(s, h, st)
+            return self._advance_free(s, h, t0, rep, st)
+        return self._advance_contact(s, h, rep, st)
 
     # ------------------------------------------------------------------ free flight
 
@@ -515,7 +530,8 @@ class TouchdownCore:
             self._turns += k
         self._psi = x
 
-    def _advance_free(self, s: float, h: float, t0: float, st: _Step) -> float:
+    def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
+                      st: _Step) -> float:
         fm = self._fm
         assert fm is not None
         work = st.work
@@ -548,7 +564,7 @@ class TouchdownCore:
         z = hit.z * (self._p.c_r / abs(hit.z))
         self._forget_clear_proof()
         if hit.kind == "impact":
-            self._impact(t0 + s + (st.s_lo + ds), z, hit.v, st)
+            self._impact(t0 + s + (st.s_lo + ds), z, hit.v, rep)
         else:
             self._z, self._v = z, hit.v
             self._enter_contact()
@@ -576,7 +592,7 @@ class TouchdownCore:
         self._clear = False
         self._envelope_at = -math.inf
 
-    def _impact(self, t: float, z: complex, v_minus: complex, tally: _Step) -> None:
+    def _impact(self, t: float, z: complex, v_minus: complex, tally: StepReport) -> None:
         p = self._p
         W = self._inputs[0]
         n = z / p.c_r
@@ -586,10 +602,10 @@ class TouchdownCore:
             r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)
         imp = Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t, r.stick, r.E_diss)
         tally.impacts.append(imp)
-        tally.P_vec -= complex(r.P_n, r.P_t) * n
+        tally.P_contact -= complex(r.P_n, r.P_t) * n
         tally.P_n += r.P_n
         tally.P_t += r.P_t
-        tally.E += r.E_diss
+        tally.E_diss += r.E_diss
         self._n_impacts += 1
         self._t_last, self._v_last = t, r.rdot
         self._z, self._v = z, r.v_plus
@@ -661,7 +677,9 @@ class TouchdownCore:
         self._z = self._p.c_r * e
         self._v = 1j * self._p.c_r * self._dtheta * e
 
-    def _advance_contact(self, s: float, h: float, st: _Step) -> float:
+    def _advance_contact(self, s: float, h: float, rep: StepReport, st: _Step) -> float:
+        """A contact segment from s seconds into the step: choose it (lift-off, rolling,
+        a rub in closed form, sliding), advance it, apply its end."""
         wf = self._wf
         assert wf is not None
         rem = (h - s) - st.s_lo
@@ -678,42 +696,42 @@ class TouchdownCore:
         if self._mode == MODE_ROLLING:
             slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if st.roll_lenient else 0.0
             end = Rolling(wf, self._theta, E, slack).run(rem)
-        elif (end := self._rub_segment(rem, E, self._may_linearise(s, sticky, st))) is None:
+        elif (rub := self._rub_choice(E, self._may_linearise(s, sticky, st))) is not None:
+            end = rub.run(rem)
+        else:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
             seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step)
             end = seg.run(self._slide_span(rem), st.cap - st.work.total)
             self._slide_step = end.next_step
         st.work.iters += end.tally.work
-        self._end_segment(end, st)
+        self._end_segment(end, rep, st)
         return st.later(s, end.duration) if end.duration < rem else h
 
-    def _end_segment(self, end: SegmentEnd, tally: _Step) -> None:
-        """Take the state, contact integrals and event at the end of a contact segment."""
+    def _end_segment(self, end: SegmentEnd, rep: StepReport, st: _Step | None) -> None:
+        """Apply the end of a contact segment: its state, its contact integrals (into
+        ``rep``) and its event (``st`` may be None only for an end without event)."""
         p = self._p
-        tally.add_contact(end.tally, p.m * p.c_r, p.c_r)
+        rep.add_contact(end.tally, p.m * p.c_r, p.c_r)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_psi(end.duration)
-        self._transition(end.event, tally)
+        self._transition(end.event, st)
         self._sync_from_contact()
 
-    def _rub_step(self, h: float, cap: int) -> StepReport | None:
+    def _rub_step(self, h: float, rep: StepReport) -> bool:
         """A sliding step on or near a stable forward rub in closed form, without the step
         loop: the rigid rotation when locked, else the linearised motion when the state
-        admits it (``_linear_rub``); None otherwise (the caller integrates). The inputs
+        admits it (``_linear_rub``); False otherwise (the step loop integrates). The inputs
         are those the rub was found under (new inputs unlock it). ``_advance_contact``
         would take the same segment whole: the slip sign agrees with v_rel, and Gn stays
         above the lift-off test (constant on the rotation; bounded below by
         LinearRub.near on the linearised motion)."""
-        end = self._rub_segment(h, self._phasor(), True)
-        if end is None:
-            return None
-        st = _Step(cap)
-        st.work.iters = end.tally.work
-        self._end_segment(end, st)
-        self._advance_clock(h)
-        rep = StepReport(work_cap=cap)
-        self._fill_report(rep, st, h)
-        return rep
+        rub = self._rub_choice(self._phasor(), True)
+        if rub is None:
+            return False
+        end = rub.run(h)
+        rep.work = end.tally.work
+        self._end_segment(end, rep, None)
+        return True
 
     def _leaves_wall(self, E: complex) -> bool:
         """Lift-off at the start of a contact segment: N < 0, or N = 0 to rounding and
@@ -730,7 +748,7 @@ class TouchdownCore:
         dd = 0.0 if self._mode == MODE_ROLLING else gt - wf.mu * self._slip * gn
         return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0
 
-    def _transition(self, event: str | None, st: _Step) -> None:
+    def _transition(self, event: str | None, st: _Step | None) -> None:
         wf = self._wf
         assert wf is not None
         if event is None:
@@ -745,6 +763,7 @@ class TouchdownCore:
             self._dtheta = -wf.wr  # cone violations below resolution are ignored this step
             self._mode = MODE_ROLLING
             self._locked = False
+            assert st is not None
             st.roll_lenient = True
         elif event == "cone":
             _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
@@ -757,12 +776,12 @@ class TouchdownCore:
         self._locked = False
         self._forget_clear_proof()
 
-    def _lock(self, lin: LinearRub | QuadraticRub, rem: float, E: complex) -> SegmentEnd:
-        """Put the state on the rub of ``lin`` (lock it) and rotate rigidly for rem s."""
+    def _lock(self, lin: LinearRub | QuadraticRub, E: complex) -> LockedRub:
+        """Put the state on the rub of ``lin`` (lock it): the rigid rotation from there."""
         self._theta = wrap_angle(lin.eq.alpha + cmath.phase(E))
         self._dtheta = lin.wf.Omega
         self._locked = True
-        return LockedRub(lin.wf, self._theta, self._dtheta, E, self._slip).run(rem)
+        return LockedRub(lin.wf, self._theta, self._dtheta, E, self._slip)
 
     def _rub_equilibria(self) -> list[RubEquilibrium]:
         """forward_rub_equilibria of the held inputs (computed once per inputs)."""
@@ -771,17 +790,18 @@ class TouchdownCore:
             self._rub_eqs = forward_rub_equilibria(self._wf)
         return self._rub_eqs
 
-    def _rub_segment(self, rem: float, E: complex, linearise: bool) -> SegmentEnd | None:
-        """A sliding segment of rem s on or near a stable forward rub in closed form: the
-        rigid rotation when locked; else, if ``linearise``, the linearised motion when the
+    def _rub_choice(self, E: complex, linearise: bool
+                    ) -> LockedRub | LinearRub | QuadraticRub | None:
+        """The sliding segment on or near a stable forward rub in closed form: the rigid
+        rotation when locked; else, if ``linearise``, the linearised motion when the
         state admits it (locking first when the snap is below LOCK_TOL); else None."""
         if self._locked:
             assert self._wf is not None
-            return LockedRub(self._wf, self._theta, self._dtheta, E, self._slip).run(rem)
+            return LockedRub(self._wf, self._theta, self._dtheta, E, self._slip)
         lin = self._linear_rub(E) if linearise else None
         if lin is None:
             return None
-        return self._lock(lin, rem, E) if lin.snap_error() <= LOCK_TOL else lin.run(rem)
+        return self._lock(lin, E) if lin.snap_error() <= LOCK_TOL else lin
 
     def _slide_span(self, rem: float) -> float:
         """How long (s) to integrate sliding before the rub's closed form is tried again:
