@@ -220,9 +220,7 @@ class TouchdownCore:
         self._E_diss = 0.0
         self._t_contact = math.nan
         self._slide_step = math.inf
-        self._inputs: tuple[float, complex, float] = (0.0, 0j, 1.0)
-        self._fm: FlightModel | None = None
-        self._wf: WallForces | None = None
+        self._set_inputs(0.0, 0j, 1.0)  # the flight and wall models of the held inputs
 
     # ------------------------------------------------------------------ constructors
 
@@ -291,10 +289,7 @@ class TouchdownCore:
         if params.c_r != self._p.c_r:
             raise ParameterError("c_r is fixed after initialisation; it cannot change mid-run")
         self._p = params
-        self._fm = None
-        self._wf = None
-        self._forget_clear_proof()
-        self._locked = False
+        self._set_inputs(*self._inputs)  # rebuilds the models; forgets the proof and the lock
 
     @property
     def t(self) -> float:
@@ -393,7 +388,7 @@ class TouchdownCore:
                 and math.isfinite(F.real) and math.isfinite(F.imag)):
             self._reject_inputs(h, Omega, F, amb_on)
         W, a = float(Omega), float(amb_on)
-        if (W, F, a) != self._inputs or self._fm is None:
+        if (W, F, a) != self._inputs:
             self._set_inputs(W, F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
         rep = StepReport(work_cap=cap)
@@ -456,7 +451,6 @@ class TouchdownCore:
         caller searches). Either way the step ends in the same state as a search that finds
         nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
-        assert fm is not None
         E = self._phasor()
         work = 1
         if not self._clear:
@@ -493,7 +487,7 @@ class TouchdownCore:
 
     def _set_inputs(self, W: float, F: complex, a: float) -> None:
         """New held inputs (or parameters): rebuild the flight and wall models."""
-        self._inputs = (W, F, a)
+        self._inputs: tuple[float, complex, float] = (W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
@@ -533,7 +527,6 @@ class TouchdownCore:
     def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
                       st: _Step) -> float:
         fm = self._fm
-        assert fm is not None
         work = st.work
         rem = (h - s) - st.s_lo
         E = self._phasor()
@@ -619,7 +612,6 @@ class TouchdownCore:
     def _outward_accel(self, n: complex, v: complex) -> float:
         """A (m/s^2): outward normal acceleration at the wall from contact-free forces."""
         wf = self._wf
-        assert wf is not None
         vt = (n.conjugate() * v).imag
         gn, _ = wf.gn_gt(cmath.phase(n), vt / self._p.c_r, self._phasor())
         return gn * self._p.c_r
@@ -637,7 +629,6 @@ class TouchdownCore:
         if p.d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
             return False
         wf = self._wf
-        assert wf is not None
         vt = (n.conjugate() * v_plus).imag
         w_ref = max(wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
         return 2.0 * vb / A <= ETA_TIME / w_ref
@@ -656,7 +647,6 @@ class TouchdownCore:
     def _choose_contact_mode(self) -> None:
         """Pick sliding (with slip sign) or rolling from the current contact state."""
         wf = self._wf
-        assert wf is not None
         vrel = wf.wr + self._dtheta
         if vrel != 0.0 or wf.mu == 0.0:  # frictionless contact always 'slides'
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, vrel)
@@ -681,7 +671,6 @@ class TouchdownCore:
         """A contact segment from s seconds into the step: choose it (lift-off, rolling,
         a rub in closed form, sliding), advance it, apply its end."""
         wf = self._wf
-        assert wf is not None
         rem = (h - s) - st.s_lo
         E = self._phasor()
         vrel = wf.wr + self._dtheta
@@ -738,7 +727,6 @@ class TouchdownCore:
         decreasing (the same tie-break as the free flight's touch test, so the two never
         disagree and hand the state back and forth)."""
         wf = self._wf
-        assert wf is not None
         gn, gt = wf.gn_gt(self._theta, self._dtheta, E)
         tol = wf.gn_tol(self._dtheta)
         if gn > tol:
@@ -750,7 +738,6 @@ class TouchdownCore:
 
     def _transition(self, event: str | None, st: _Step | None) -> None:
         wf = self._wf
-        assert wf is not None
         if event is None:
             return
         if event == "lift_off":
@@ -786,7 +773,6 @@ class TouchdownCore:
     def _rub_equilibria(self) -> list[RubEquilibrium]:
         """forward_rub_equilibria of the held inputs (computed once per inputs)."""
         if self._rub_eqs is None:
-            assert self._wf is not None
             self._rub_eqs = forward_rub_equilibria(self._wf)
         return self._rub_eqs
 
@@ -796,7 +782,6 @@ class TouchdownCore:
         rotation when locked; else, if ``linearise``, the linearised motion when the
         state admits it (locking first when the snap is below LOCK_TOL); else None."""
         if self._locked:
-            assert self._wf is not None
             return LockedRub(self._wf, self._theta, self._dtheta, E, self._slip)
         lin = self._linear_rub(E) if linearise else None
         if lin is None:
@@ -807,7 +792,6 @@ class TouchdownCore:
         """How long (s) to integrate sliding before the rub's closed form is tried again:
         rem, or RUB_RETRY/w if shorter when a stable forward rub exists."""
         wf = self._wf
-        assert wf is not None
         if any(eq.stable for eq in self._rub_equilibria()):
             return min(rem, RUB_RETRY / wf.omega_ref(self._dtheta))
         return rem
@@ -823,7 +807,6 @@ class TouchdownCore:
         LINEAR_TOL and its error budget holds (LinearRub.near), else to second order when
         within QUAD_TOL and its budget holds (QuadraticRub.near); None otherwise."""
         wf = self._wf
-        assert wf is not None
         th, dth, slip = self._theta, self._dtheta, self._slip
         for eq in self._rub_equilibria():  # (none when q0 != 0)
             dev = rub_deviation(wf, eq, th, dth, E, slip, QUAD_TOL)
