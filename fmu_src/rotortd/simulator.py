@@ -204,7 +204,7 @@ class TouchdownCore:
         self._p = params
         self._t = float(t0)
         self._t_lo = 0.0  # compensation of the clock (Kahan), s
-        self._z, self._v = z0, v0
+        self._z, self._v = z0, v0  # the state in flight (m, m/s); in contact: _theta, _dtheta
         self._psi, self._turns = wrap_angle(float(psi0)), 0
         self._turns = round((float(psi0) - self._psi) / TWO_PI_HI)
         self._mode = MODE_FREE
@@ -299,12 +299,12 @@ class TouchdownCore:
     @property
     def z(self) -> complex:
         """Position of the rotor centre (m), inertial."""
-        return self._z
+        return self._wall_state()[0] if self._mode else self._z
 
     @property
     def v(self) -> complex:
         """Velocity of the rotor centre (m/s), inertial."""
-        return self._v
+        return self._wall_state()[1] if self._mode else self._v
 
     @property
     def psi(self) -> float:
@@ -355,7 +355,11 @@ class TouchdownCore:
         """The fields of ``kinematics`` as a plain tuple, in the same order (cheaper)."""
         W = self._inputs[0] if Omega is None else Omega
         a = self._inputs[2] if amb_on is None else amb_on
-        p, z, v, psi = self._p, self._z, self._v, self._psi
+        if self._mode:  # in contact the state is (theta, theta')
+            z, v = self._wall_state()
+        else:
+            z, v = self._z, self._v
+        p, psi = self._p, self._psi
         c_r = p.c_r
         rot = cmath.exp(-1j * psi)
         zr = z * rot
@@ -642,7 +646,6 @@ class TouchdownCore:
         self._dtheta = ((z / abs(z)).conjugate() * v).imag / self._p.c_r
         self._locked = False
         self._choose_contact_mode()
-        self._sync_from_contact()
 
     def _choose_contact_mode(self) -> None:
         """Pick sliding (with slip sign) or rolling from the current contact state."""
@@ -661,11 +664,11 @@ class TouchdownCore:
         else:
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
 
-    def _sync_from_contact(self) -> None:
-        """Set (z, v) from (theta, theta')."""
+    def _wall_state(self) -> tuple[complex, complex]:
+        """(z (m), v (m/s)) of the contact state (theta, theta'): in contact the core holds
+        the state only as (theta, theta'), and (z, v) follow from it."""
         e = cmath.exp(1j * self._theta)
-        self._z = self._p.c_r * e
-        self._v = 1j * self._p.c_r * self._dtheta * e
+        return self._p.c_r * e, 1j * self._p.c_r * self._dtheta * e
 
     def _advance_contact(self, s: float, h: float, rep: StepReport, st: _Step) -> float:
         """A contact segment from s seconds into the step: choose it (lift-off, rolling,
@@ -704,7 +707,6 @@ class TouchdownCore:
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_psi(end.duration)
         self._transition(end.event, st)
-        self._sync_from_contact()
 
     def _rub_step(self, h: float, rep: StepReport) -> bool:
         """A sliding step on or near a stable forward rub in closed form, without the step
@@ -757,7 +759,7 @@ class TouchdownCore:
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
 
     def _lift_off(self) -> None:
-        self._sync_from_contact()
+        self._z, self._v = self._wall_state()
         self._mode = MODE_FREE
         self._on_wall = True
         self._locked = False
@@ -823,15 +825,15 @@ class TouchdownCore:
 
     def get_state(self) -> dict:
         """All internal state as a JSON-serialisable dict (floats round-trip exactly)."""
-        p = self._p
+        p, z, v = self._p, self.z, self.v
         return {
             "schema": STATE_SCHEMA,
             "version": STATE_VERSION,
             "params": {f: getattr(p, f) for f in p.__dataclass_fields__},
             "t": self._t,
             "t_lo": self._t_lo,
-            "z": [self._z.real, self._z.imag],
-            "v": [self._v.real, self._v.imag],
+            "z": [z.real, z.imag],
+            "v": [v.real, v.imag],
             "psi": self._psi,
             "turns": self._turns,
             "mode": self._mode,
