@@ -275,7 +275,7 @@ def test_closed_form_rub_steps_agree_with_integrating_the_sliding(t_start: float
         assert abs(a.F_contact - b.F_contact) <= 1e-13 * abs(b.F_contact)
         assert abs(core.z - twin.z) <= 1e-13 * core.params.c_r
         assert abs(core.v - twin.v) <= 1e-13 * abs(twin.v)
-    assert core._locked == locked
+    assert core.state.locked == locked
 
 
 def test_linearised_rub_is_refused_outside_its_error_budget() -> None:
@@ -285,21 +285,21 @@ def test_linearised_rub_is_refused_outside_its_error_budget() -> None:
     slip sign."""
     core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
     _run(core, 0.2, 1e-3)
-    assert core._linear_rub(core._phasor()) is None
+    assert core._linear_rub(cmath.exp(1j * core.state.psi)) is None
     _run(core, 0.3, 1e-3)
-    E = core._phasor()
-    stable = next(e for e in forward_rub_equilibria(core._wf) if e.stable)
-    assert LinearRub.near(core._wf, stable, core._theta, core._dtheta, E, core._slip) is None
+    st, E = core.state, cmath.exp(1j * core.state.psi)
+    stable = next(e for e in forward_rub_equilibria(core.wall_forces) if e.stable)
+    assert LinearRub.near(core.wall_forces, stable, st.theta, st.dtheta, E, st.slip) is None
     assert isinstance(core._linear_rub(E), QuadraticRub)
     _run(core, 0.45, 1e-3)
-    E = core._phasor()
+    st, E = core.state, cmath.exp(1j * core.state.psi)
     assert core._linear_rub(E) is not None
-    wf = core._wf
+    wf = core.wall_forces
     stable, saddle = sorted(forward_rub_equilibria(wf), key=lambda e: not e.stable)
-    assert LinearRub.near(wf, saddle, core._theta, core._dtheta, E, core._slip) is None
-    assert LinearRub.near(wf, stable, core._theta, core._dtheta, E, -core._slip) is None
-    for eq, slip in ((saddle, core._slip), (stable, -core._slip)):
-        assert QuadraticRub.near(wf, eq, core._theta, core._dtheta, E, slip) is None
+    assert LinearRub.near(wf, saddle, st.theta, st.dtheta, E, st.slip) is None
+    assert LinearRub.near(wf, stable, st.theta, st.dtheta, E, -st.slip) is None
+    for eq, slip in ((saddle, st.slip), (stable, -st.slip)):
+        assert QuadraticRub.near(wf, eq, st.theta, st.dtheta, E, slip) is None
 
 
 def _sliding_impulse_case(case: str) -> tuple[TouchdownCore, complex, float]:

@@ -54,10 +54,10 @@ from .impact import Impact, reset
 from .limits import CrossParameterError, start_position
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
 from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
+from .state import CoreState
 
 MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
 STATUS_OK, STATUS_WORK_CAP = 0, 1
-STATE_SCHEMA, STATE_VERSION = "rotortd-state", 1
 _MODE_NAMES = {MODE_FREE: "lift_off", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
 
 ETA_HEIGHT = 1e-14
@@ -823,60 +823,43 @@ class TouchdownCore:
 
     # ------------------------------------------------------------------ state (de)serialisation
 
-    def get_state(self) -> dict:
-        """All internal state as a JSON-serialisable dict (floats round-trip exactly)."""
-        p, z, v = self._p, self.z, self.v
-        return {
-            "schema": STATE_SCHEMA,
-            "version": STATE_VERSION,
-            "params": {f: getattr(p, f) for f in p.__dataclass_fields__},
-            "t": self._t,
-            "t_lo": self._t_lo,
-            "z": [z.real, z.imag],
-            "v": [v.real, v.imag],
-            "psi": self._psi,
-            "turns": self._turns,
-            "mode": self._mode,
-            "theta": self._theta,
-            "dtheta": self._dtheta,
-            "slip": self._slip,
-            "locked": self._locked,
-            "on_wall": self._on_wall,
-            "n_impacts": self._n_impacts,
-            "t_last": self._t_last,
-            "v_last": self._v_last,
-            "E_diss": self._E_diss,
-            "t_contact": None if math.isnan(self._t_contact) else self._t_contact,
-            "H": None if math.isinf(self._slide_step) else self._slide_step,
-            "inputs": [
-                self._inputs[0],
-                self._inputs[1].real,
-                self._inputs[1].imag,
-                self._inputs[2],
-            ],
-        }
+    @property
+    def wall_forces(self) -> WallForces:
+        """The contact-free forces at the wall under the held inputs (per unit m c_r)."""
+        return self._wf
 
-    def set_state(self, st: dict) -> None:
-        """Restore a state produced by get_state (same or compatible version)."""
-        if st.get("schema") != STATE_SCHEMA or st.get("version") != STATE_VERSION:
-            raise ParameterError(
-                f"state schema {st.get('schema')!r} version {st.get('version')!r} is not "
-                f"supported: expected {STATE_SCHEMA!r} version {STATE_VERSION}"
-            )
-        self._p = RotorParams(**st["params"])
-        self._t = float(st["t"])
-        self._t_lo = float(st["t_lo"])
-        self._z = complex(*st["z"])
-        self._v = complex(*st["v"])
-        self._psi, self._turns = float(st["psi"]), int(st["turns"])
-        self._mode = int(st["mode"])
-        self._theta, self._dtheta = float(st["theta"]), float(st["dtheta"])
-        W, fx, fy, a = st["inputs"]
-        self._set_inputs(float(W), complex(fx, fy), float(a))  # clears _locked: restored next
-        self._slip, self._locked = float(st["slip"]), bool(st["locked"])
-        self._on_wall = bool(st["on_wall"])
-        self._n_impacts = int(st["n_impacts"])
-        self._t_last, self._v_last = float(st["t_last"]), float(st["v_last"])
-        self._E_diss = float(st["E_diss"])
-        self._t_contact = math.nan if st["t_contact"] is None else float(st["t_contact"])
-        self._slide_step = math.inf if st["H"] is None else float(st["H"])
+    @property
+    def state(self) -> CoreState:
+        """The state as a plain record (read-only; ``set_state`` restores one)."""
+        return CoreState(
+            params=self._p, t=self._t, t_lo=self._t_lo, z=self.z, v=self.v, psi=self._psi,
+            turns=self._turns, mode=self._mode, theta=self._theta, dtheta=self._dtheta,
+            slip=self._slip, locked=self._locked, on_wall=self._on_wall,
+            n_impacts=self._n_impacts, t_last=self._t_last, v_last=self._v_last,
+            E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
+            inputs=self._inputs,
+        )
+
+    def get_state(self) -> dict:
+        """All internal state as a JSON-serialisable dict (floats round-trip exactly):
+        ``CoreState.to_json`` of ``state``."""
+        return self.state.to_json()
+
+    def set_state(self, st: dict | CoreState) -> None:
+        """Restore a state produced by get_state (same or compatible version), or a
+        CoreState; ParameterError for another schema or version (nothing changes)."""
+        cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
+        self._p = cs.params
+        self._t, self._t_lo = cs.t, cs.t_lo
+        self._z, self._v = cs.z, cs.v
+        self._psi, self._turns = cs.psi, cs.turns
+        self._mode = cs.mode
+        self._theta, self._dtheta = cs.theta, cs.dtheta
+        self._set_inputs(*cs.inputs)  # clears _locked: restored next
+        self._slip, self._locked = cs.slip, cs.locked
+        self._on_wall = cs.on_wall
+        self._n_impacts = cs.n_impacts
+        self._t_last, self._v_last = cs.t_last, cs.v_last
+        self._E_diss = cs.E_diss
+        self._t_contact = cs.t_contact
+        self._slide_step = cs.slide_step
