@@ -6,180 +6,53 @@ returns a ``StepReport``. The story it resolves:
 
     free flight -> impacts -> chattering -> sliding <-> rolling -> lift-off -> free flight
 
-Low-speed rule (when an impact becomes sustained contact). At an impact with normal speed
-v, let A > 0 be the outward normal acceleration the contact-free forces give at the wall
-(the rotor would come back), v_b = d v the rebound speed, h_b = v_b^2/(2A) the rebound
-height and tau_b = 2 v_b/A its flight time. The impact is made plastic and sustained
-contact begins when
-
-  (1) h_b <= ETA_HEIGHT c_r (the remaining chattering cascade is below resolution), or
-  (2) the cascade to (1) would need more than N_CASCADE further impacts (d close to 1,
-      or d = 1 where it never ends) and the bounce is short, tau_b <= ETA_TIME/w_ref,
-      w_ref = max(|Omega|, |theta'|, sqrt(kappa), beta, sqrt(A/c_r)).
-
-Rule (1) replaces a cascade with total normal momentum m(1+d)v/(1-d) by a plastic impact
-m v plus sliding, which delivers the rest in the accumulation time 2 d v/((1-d) A): the
-same momentum and friction impulse, so the state after the accumulation point is off by
-O(h_b) in position and O(v_b^2/((1-d)A c_r)) in phase. Rule (2) replaces bounces of height
-at most ETA_TIME^2 c_r/8 by sliding; the bounce energy 1/2 m v_b^2 (which d < 1 would
-dissipate later, d = 1 never) is dissipated at once. Neither threshold depends on the
-communication step.
+The step's segments live in two mixins, by job: ``flight_step.FlightSteps`` (free flight,
+the contact search, impacts and the low-speed rule that turns an impact into contact) and
+``contact_step.ContactSteps`` (sustained contact: the mode choice, lift-off, sliding,
+rolling, the rub in closed form, the lock). The report and the step context are in
+``report``, the state record in ``state``.
 """
 
 from __future__ import annotations
 
 import cmath
 import math
-from dataclasses import dataclass, field
-from typing import NamedTuple
 
-from .contact import (
-    QUAD_TOL,
-    ContactTally,
-    ContactWorkExceeded,
-    LinearRub,
-    LockedRub,
-    QuadraticRub,
-    Rolling,
-    RubEquilibrium,
-    SegmentEnd,
-    Sliding,
-    WallForces,
-    forward_rub_equilibria,
-    rub_deviation,
-)
-from .events import SEGMENT_WORK, WORK_MAX, ContactLocator, Work, flight_is_clear
+from .contact_step import LOCK_TOL, RUB_RETRY, ContactSteps
+from .events import SEGMENT_WORK, WORK_MAX
 from .flight import FlightModel
-from .impact import Impact, reset
+from .flight_step import ETA_HEIGHT, ETA_TIME, N_CASCADE, FlightSteps
 from .limits import CrossParameterError, start_position
 from .params import InputError, ParameterError, RotorParams, check_finite, check_range
+from .report import (
+    _MODE_NAMES,
+    _PROVED_FREE,
+    _RUB,
+    _SEGMENT_NAMES,
+    MODE_FREE,
+    MODE_ROLLING,
+    MODE_SLIDING,
+    STATUS_OK,
+    STATUS_WORK_CAP,
+    Kinematics,
+    StepContext,
+    StepReport,
+    WorkCapExceeded,
+    work_cap,
+)
+from .rub import RubEquilibrium
 from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 from .state import CoreState
+from .wall import ContactWorkExceeded, WallForces
 
-MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
-STATUS_OK, STATUS_WORK_CAP = 0, 1
-_MODE_NAMES = {MODE_FREE: "lift_off", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
-
-ETA_HEIGHT = 1e-14
-"""Rule (1): rebound height below ETA_HEIGHT c_r counts as contact."""
-ETA_TIME = 1e-3
-"""Rule (2): rebound flight time below ETA_TIME / w_ref counts as contact (long cascades)."""
-N_CASCADE = 1000
-"""Rule (2) applies when more than N_CASCADE impacts would remain before rule (1)."""
-LOCK_TOL = 1e-14
-"""A sliding state on the linearised rub (contact.LinearRub) whose snap_error is at most
-LOCK_TOL is put exactly on the stable forward rub and advanced as a rigid rotation: the
-snap changes the angle, the rate and the normal force by at most LOCK_TOL relative."""
-RUB_RETRY = 4.0
-"""Longest sliding segment, in units of 1/w (WallForces.omega_ref), integrated before the
-linearised rub and the lock are tried again, when a stable forward rub exists. Without it
-a long step integrated all of its sliding, however close to the rub it came (a 10 s step
-at the rub cost 0.19 s CPU)."""
-_R_CLEAR = 1.0 - 1e-9
+__all__ = [
+    "ETA_HEIGHT", "ETA_TIME", "LOCK_TOL", "MODE_FREE", "MODE_ROLLING", "MODE_SLIDING",
+    "N_CASCADE", "RUB_RETRY", "STATUS_OK", "STATUS_WORK_CAP", "WORK_MAX", "Kinematics",
+    "StepReport", "TouchdownCore", "WorkCapExceeded", "work_cap",
+]
 
 
-class WorkCapExceeded(RuntimeError):
-    """A step exceeded its work cap."""
-
-
-@dataclass(slots=True)
-class StepReport:
-    """What happened in one step (SI, inertial). Forces are step averages (impulse/h).
-
-    Also the step's accumulator: while the step runs, impacts and contact segments add
-    their impulses to P_contact, P_n, P_t, E_diss and F_n_peak (the contact force's peak;
-    the impacts' P_n/h join it at the end), and the step's end turns the impulses into the
-    averages F_contact, F_n and T_f (``TouchdownCore._finish``)."""
-
-    status: int = STATUS_OK
-    message: str = ""
-    impacts: list[Impact] = field(default_factory=list)
-    F_contact: complex = 0j
-    F_n: float = 0.0
-    F_n_peak: float = 0.0
-    P_n: float = 0.0
-    T_f: float = 0.0
-    E_diss: float = 0.0
-    mode: int = MODE_FREE
-    work: int = 0
-    work_cap: int = 0
-    transitions: list[tuple[float, str]] = field(default_factory=list)
-    """Mode changes in the step: (t, "sliding" | "rolling" | "lift_off")."""
-    P_contact: complex = 0j
-    """Impulse of the contact on the rotor over the step (N s): F_contact = P_contact/h."""
-    P_t: float = 0.0
-    """Signed friction impulse (N s): T_f = -R P_t/h."""
-
-    def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
-        """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
-        self.P_contact += mc * tal.I_c
-        self.P_n += mc * tal.I_n
-        self.P_t += mc * tal.I_t
-        self.E_diss += mc * c_r * tal.I_e
-        self.F_n_peak = max(self.F_n_peak, mc * tal.peak)
-
-
-class Kinematics(NamedTuple):
-    """Outputs derived from the state (SI; u_*, du_* scaled co-rotating, t = Omega tau).
-
-    x, y (m), vx, vy (m/s), r_rel = |z|/c_r, u = z e^{-i psi}/c_r, du = dU/dt (0 when
-    Omega = 0), psi_wrapped (rad, (-pi, pi]), whirl_rate theta' (rad/s, inertial),
-    v_rel = R Omega + c_r theta' (m/s), F_amb = a (F_bias - c v - k z) (N). A named tuple:
-    the fields unpack in this order.
-    """
-
-    x: float
-    y: float
-    vx: float
-    vy: float
-    r_rel: float
-    u_re: float
-    u_im: float
-    du_re: float
-    du_im: float
-    psi_wrapped: float
-    whirl_rate: float
-    v_rel: float
-    F_amb_x: float
-    F_amb_y: float
-
-
-class _Step:
-    """The context of a step taken segment by segment, passed down the step loop and
-    never stored on the core: its work and work bound, the rounding error of its local
-    time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
-
-    __slots__ = ("cap", "roll_lenient", "rub_refused", "s_lo", "sticky_at", "work")
-
-    def __init__(self, cap: int, rub_refused: bool = False) -> None:
-        self.work = Work()
-        self.cap = cap  # work bound (units)
-        self.s_lo = 0.0  # rounding error of the step-local time (later), s
-        self.roll_lenient = False  # zero slip proved stuck (_transition)
-        self.sticky_at = math.nan  # where flight and contact swapped at N = 0
-        self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
-
-    def later(self, s: float, ds: float) -> float:
-        """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step
-        of many events would otherwise drift by one rounding per event."""
-        t = s + ds
-        r = t - s
-        self.s_lo += (s - (t - r)) + (ds - r)
-        return t
-
-
-def work_cap(*_args: object) -> int:
-    """The work bound of one step (units): the constant WORK_MAX, whatever the scene and
-    the step length (docs/model.md 7). The arguments (parameters, h, Omega, F_ext, amb_on,
-    speed, as the former rate-based cap took them) are accepted and ignored."""
-    return WORK_MAX
-
-
-_SEGMENT_NAMES = {MODE_FREE: "free flight", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
-_PROVED_FREE, _RUB = "proved free flight", "rub in closed form"  # _whole_step's choices
-
-
-class TouchdownCore:
+class TouchdownCore(FlightSteps, ContactSteps):
     """Rotor in a touchdown bearing, advanced step by step (see the module docstring)."""
 
     def __init__(
@@ -399,7 +272,7 @@ class TouchdownCore:
         t0, s = self._t, h
         whole = self._whole_step(h, rep)  # choose: the whole step in one closed form?
         if whole is None:  # else segment by segment, each chosen where the last ended
-            s = self._segments(h, t0, rep, _Step(cap, self._mode == MODE_SLIDING))
+            s = self._segments(h, t0, rep, StepContext(cap, self._mode == MODE_SLIDING))
         self._finish(rep, t0, s, h, whole is not _PROVED_FREE)
         return rep
 
@@ -414,7 +287,7 @@ class TouchdownCore:
             return _RUB if self._rub_step(h, rep) else None
         return None
 
-    def _segments(self, h: float, t0: float, rep: StepReport, st: _Step) -> float:
+    def _segments(self, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
         """The step loop: choose the next segment from the state, advance it, apply its
         end (``_advance``), until the step is done or its work bound is reached. Returns
         how far (s) into the step it got."""
@@ -447,31 +320,6 @@ class TouchdownCore:
         self._advance_clock(h if s >= h else s)
         if tallied:
             self._fill_report(rep, self._t - t0 if s < h else h)
-
-    def _proved_free_step(self, h: float, rep: StepReport) -> bool:
-        """A free step proved contact-free without a search: by the envelope for all time
-        under the held inputs (``_clear``), or by the cubic bound of ``flight_is_clear`` over
-        the whole step. Then one closed-form propagation, nothing to tally; else None (the
-        caller searches). Either way the step ends in the same state as a search that finds
-        nothing, which also propagates once from the start. True when taken."""
-        fm = self._fm
-        E = self._phasor()
-        work = 1
-        if not self._clear:
-            if self._on_wall:
-                return False
-            if self._t >= self._envelope_at:
-                work += 1
-                self._check_envelope(fm, self._t, E)
-            if not self._clear:
-                work += 1
-                if not flight_is_clear(fm, self._z, self._v, E, h):
-                    return False
-        self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
-        self._advance_psi(h)
-        self._on_wall = False
-        rep.work = work
-        return True
 
     @staticmethod
     def _reject_inputs(h: float, Omega: float, F: complex, amb_on: float) -> None:
@@ -509,317 +357,11 @@ class TouchdownCore:
         rep.mode = self._mode
         self._E_diss += rep.E_diss
 
-    def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: _Step) -> float:
+    def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
         """One segment from s seconds into the step: flight or contact, by the mode."""
         if self._mode == MODE_FREE:
             return self._advance_free(s, h, t0, rep, st)
         return self._advance_contact(s, h, rep, st)
-
-    # ------------------------------------------------------------------ free flight
-
-    def _phasor(self) -> complex:
-        return cmath.exp(1j * self._psi)
-
-    def _advance_psi(self, ds: float) -> None:
-        x = self._psi + self._inputs[0] * ds
-        k = math.floor((x + math.pi) / TWO_PI_HI)
-        if k:
-            x = (x - k * TWO_PI_HI) - k * TWO_PI_LO
-            self._turns += k
-        self._psi = x
-
-    def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
-                      st: _Step) -> float:
-        fm = self._fm
-        work = st.work
-        rem = (h - s) - st.s_lo
-        E = self._phasor()
-        if not self._clear and not self._on_wall and t0 + s >= self._envelope_at:
-            work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
-            self._check_envelope(fm, t0 + s, E)
-        hit = loc = None
-        if not self._clear:
-            loc = ContactLocator(fm, self._z, self._v, E)
-            hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
-        if hit is None:
-            if loc is not None and s > 0.0:
-                # the rest of a step after an event: a length that will not recur, whose
-                # flight map costs twelve times the search's modal state (measured)
-                self._z, self._v, _ = loc.state(rem, work)
-            else:  # a whole step: its length recurs and its flight map is cached
-                work.evals += 1
-                self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
-            self._advance_psi(rem)
-            self._on_wall = False
-            return h
-        ds = min(hit.s, rem)
-        self._advance_psi(ds)
-        if hit.kind == "clear":
-            self._z, self._v = hit.z, hit.v
-            self._on_wall = False
-            return st.later(s, ds)
-        z = hit.z * (self._p.c_r / abs(hit.z))
-        self._forget_clear_proof()
-        if hit.kind == "impact":
-            self._impact(t0 + s + (st.s_lo + ds), z, hit.v, rep)
-        else:
-            self._z, self._v = z, hit.v
-            self._enter_contact()
-        return st.later(s, ds)
-
-    def _check_envelope(self, fm: FlightModel, t: float, E: complex) -> None:
-        """Try to prove the flight clear of the wall for all time under the held inputs
-        (``_clear``). If that fails, schedule the next try for when the transient bound,
-        decaying like e^{-decay_rate t}, could have fallen below the margin left by the
-        steady whirl; never, if the steady whirl alone reaches the wall. The schedule only
-        saves work: a flight that is not proved clear is searched, which is always exact.
-        Not tried from the wall (after an impact or lift-off): sup |z| >= |z(0)| = c_r there,
-        so the proof must fail; the next step that starts off the wall tries again."""
-        steady, transient = fm.radius_bound_parts(self._z, self._v, E)
-        limit = self._p.c_r * _R_CLEAR
-        if steady + transient < limit:
-            self._clear = True
-        elif steady < limit and fm.decay_rate > 0.0 and math.isfinite(transient):
-            self._envelope_at = t + math.log(transient / (limit - steady)) / fm.decay_rate
-        else:
-            self._envelope_at = math.inf
-
-    def _forget_clear_proof(self) -> None:
-        """Forget the envelope proof: the state jumped or the inputs changed."""
-        self._clear = False
-        self._envelope_at = -math.inf
-
-    def _impact(self, t: float, z: complex, v_minus: complex, tally: StepReport) -> None:
-        p = self._p
-        W = self._inputs[0]
-        n = z / p.c_r
-        r = reset(n, v_minus, p.m, p.d, p.mu, p.R, W)
-        plastic = self._low_speed_contact(n, r.rdot, r.v_plus)
-        if plastic:
-            r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)
-        imp = Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t, r.stick, r.E_diss)
-        tally.impacts.append(imp)
-        tally.P_contact -= complex(r.P_n, r.P_t) * n
-        tally.P_n += r.P_n
-        tally.P_t += r.P_t
-        tally.E_diss += r.E_diss
-        self._n_impacts += 1
-        self._t_last, self._v_last = t, r.rdot
-        self._z, self._v = z, r.v_plus
-        self._on_wall = True
-        if plastic:
-            A = self._outward_accel(n, r.v_plus)
-            d = p.d
-            self._t_contact = t + (2.0 * d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)
-            self._enter_contact()
-
-    def _outward_accel(self, n: complex, v: complex) -> float:
-        """A (m/s^2): outward normal acceleration at the wall from contact-free forces."""
-        wf = self._wf
-        vt = (n.conjugate() * v).imag
-        gn, _ = wf.gn_gt(cmath.phase(n), vt / self._p.c_r, self._phasor())
-        return gn * self._p.c_r
-
-    def _low_speed_contact(self, n: complex, v: float, v_plus: complex) -> bool:
-        """The low-speed rule of the module docstring: does this impact start contact?"""
-        p = self._p
-        A = self._outward_accel(n, v_plus)
-        if A <= 0.0:
-            return False
-        vb = p.d * v
-        if vb * vb <= 2.0 * A * ETA_HEIGHT * p.c_r:
-            return True
-        v1 = math.sqrt(2.0 * A * ETA_HEIGHT * p.c_r)
-        if p.d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
-            return False
-        wf = self._wf
-        vt = (n.conjugate() * v_plus).imag
-        w_ref = max(wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
-        return 2.0 * vb / A <= ETA_TIME / w_ref
-
-    # ------------------------------------------------------------------ contact
-
-    def _enter_contact(self) -> None:
-        """Switch to sustained contact at the current (on-wall) state."""
-        z, v = self._z, self._v
-        self._theta = cmath.phase(z)
-        self._dtheta = ((z / abs(z)).conjugate() * v).imag / self._p.c_r
-        self._locked = False
-        self._choose_contact_mode()
-
-    def _choose_contact_mode(self) -> None:
-        """Pick sliding (with slip sign) or rolling from the current contact state."""
-        wf = self._wf
-        vrel = wf.wr + self._dtheta
-        if vrel != 0.0 or wf.mu == 0.0:  # frictionless contact always 'slides'
-            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, vrel)
-            return
-        E = self._phasor()
-        _, gt = wf.gn_gt(self._theta, self._dtheta, E)
-        margin, rate = wf.cone_margin(self._theta, self._dtheta, E)
-        tol = wf.gn_tol(self._dtheta) * (1.0 + wf.mu)
-        # inside the cone, entering it, or on its edge with no tendency to leave: roll
-        if margin > tol or (margin >= -tol and rate > 0.0) or (margin >= 0.0 and rate == 0.0):
-            self._mode = MODE_ROLLING
-        else:
-            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
-
-    def _wall_state(self) -> tuple[complex, complex]:
-        """(z (m), v (m/s)) of the contact state (theta, theta'): in contact the core holds
-        the state only as (theta, theta'), and (z, v) follow from it."""
-        e = cmath.exp(1j * self._theta)
-        return self._p.c_r * e, 1j * self._p.c_r * self._dtheta * e
-
-    def _advance_contact(self, s: float, h: float, rep: StepReport, st: _Step) -> float:
-        """A contact segment from s seconds into the step: choose it (lift-off, rolling,
-        a rub in closed form, sliding), advance it, apply its end."""
-        wf = self._wf
-        rem = (h - s) - st.s_lo
-        E = self._phasor()
-        vrel = wf.wr + self._dtheta
-        if (self._mode == MODE_ROLLING and vrel != 0.0) or (
-            self._mode == MODE_SLIDING and vrel * self._slip <= 0.0 and wf.mu != 0.0
-        ):
-            self._choose_contact_mode()  # the host changed Omega: the slip follows v_rel
-        sticky = s == st.sticky_at
-        if not sticky and self._leaves_wall(E):
-            self._lift_off()
-            return s
-        if self._mode == MODE_ROLLING:
-            slack = 2.0 * wf.gn_tol(self._dtheta) * (1.0 + wf.mu) if st.roll_lenient else 0.0
-            end = Rolling(wf, self._theta, E, slack).run(rem)
-        elif (rub := self._rub_choice(E, self._may_linearise(s, sticky, st))) is not None:
-            end = rub.run(rem)
-        else:
-            slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
-            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step)
-            end = seg.run(self._slide_span(rem), st.cap - st.work.total)
-            self._slide_step = end.next_step
-        st.work.iters += end.tally.work
-        self._end_segment(end, rep, st)
-        return st.later(s, end.duration) if end.duration < rem else h
-
-    def _end_segment(self, end: SegmentEnd, rep: StepReport, st: _Step | None) -> None:
-        """Apply the end of a contact segment: its state, its contact integrals (into
-        ``rep``) and its event (``st`` may be None only for an end without event)."""
-        p = self._p
-        rep.add_contact(end.tally, p.m * p.c_r, p.c_r)
-        self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
-        self._advance_psi(end.duration)
-        self._transition(end.event, st)
-
-    def _rub_step(self, h: float, rep: StepReport) -> bool:
-        """A sliding step on or near a stable forward rub in closed form, without the step
-        loop: the rigid rotation when locked, else the linearised motion when the state
-        admits it (``_linear_rub``); False otherwise (the step loop integrates). The inputs
-        are those the rub was found under (new inputs unlock it). ``_advance_contact``
-        would take the same segment whole: the slip sign agrees with v_rel, and Gn stays
-        above the lift-off test (constant on the rotation; bounded below by
-        LinearRub.near on the linearised motion)."""
-        rub = self._rub_choice(self._phasor(), True)
-        if rub is None:
-            return False
-        end = rub.run(h)
-        rep.work = end.tally.work
-        self._end_segment(end, rep, None)
-        return True
-
-    def _leaves_wall(self, E: complex) -> bool:
-        """Lift-off at the start of a contact segment: N < 0, or N = 0 to rounding and
-        decreasing (the same tie-break as the free flight's touch test, so the two never
-        disagree and hand the state back and forth)."""
-        wf = self._wf
-        gn, gt = wf.gn_gt(self._theta, self._dtheta, E)
-        tol = wf.gn_tol(self._dtheta)
-        if gn > tol:
-            return False
-        if gn < -tol:
-            return True
-        dd = 0.0 if self._mode == MODE_ROLLING else gt - wf.mu * self._slip * gn
-        return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0
-
-    def _transition(self, event: str | None, st: _Step | None) -> None:
-        wf = self._wf
-        if event is None:
-            return
-        if event == "lift_off":
-            self._lift_off()
-        elif event == "slip_zero":
-            self._dtheta = -wf.wr
-            self._choose_contact_mode()
-            self._locked = False
-        elif event == "slip_stuck":  # sliding cannot leave zero slip: it rolls, and
-            self._dtheta = -wf.wr  # cone violations below resolution are ignored this step
-            self._mode = MODE_ROLLING
-            self._locked = False
-            assert st is not None
-            st.roll_lenient = True
-        elif event == "cone":
-            _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
-            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
-
-    def _lift_off(self) -> None:
-        self._z, self._v = self._wall_state()
-        self._mode = MODE_FREE
-        self._on_wall = True
-        self._locked = False
-        self._forget_clear_proof()
-
-    def _lock(self, lin: LinearRub | QuadraticRub, E: complex) -> LockedRub:
-        """Put the state on the rub of ``lin`` (lock it): the rigid rotation from there."""
-        self._theta = wrap_angle(lin.eq.alpha + cmath.phase(E))
-        self._dtheta = lin.wf.Omega
-        self._locked = True
-        return LockedRub(lin.wf, self._theta, self._dtheta, E, self._slip)
-
-    def _rub_equilibria(self) -> list[RubEquilibrium]:
-        """forward_rub_equilibria of the held inputs (computed once per inputs)."""
-        if self._rub_eqs is None:
-            self._rub_eqs = forward_rub_equilibria(self._wf)
-        return self._rub_eqs
-
-    def _rub_choice(self, E: complex, linearise: bool
-                    ) -> LockedRub | LinearRub | QuadraticRub | None:
-        """The sliding segment on or near a stable forward rub in closed form: the rigid
-        rotation when locked; else, if ``linearise``, the linearised motion when the
-        state admits it (locking first when the snap is below LOCK_TOL); else None."""
-        if self._locked:
-            return LockedRub(self._wf, self._theta, self._dtheta, E, self._slip)
-        lin = self._linear_rub(E) if linearise else None
-        if lin is None:
-            return None
-        return self._lock(lin, E) if lin.snap_error() <= LOCK_TOL else lin
-
-    def _slide_span(self, rem: float) -> float:
-        """How long (s) to integrate sliding before the rub's closed form is tried again:
-        rem, or RUB_RETRY/w if shorter when a stable forward rub exists."""
-        wf = self._wf
-        if any(eq.stable for eq in self._rub_equilibria()):
-            return min(rem, RUB_RETRY / wf.omega_ref(self._dtheta))
-        return rem
-
-    def _may_linearise(self, s: float, sticky: bool, st: _Step) -> bool:
-        """May a sliding segment starting s seconds into the step try the linearised rub?
-        Not when sticky, nor at the step's start when _rub_step has refused that state."""
-        refused, st.rub_refused = st.rub_refused and s == 0.0, False
-        return not (sticky or refused)
-
-    def _linear_rub(self, E: complex) -> LinearRub | QuadraticRub | None:
-        """The closed-form sliding near a stable forward rub: linearised when within
-        LINEAR_TOL and its error budget holds (LinearRub.near), else to second order when
-        within QUAD_TOL and its budget holds (QuadraticRub.near); None otherwise."""
-        wf = self._wf
-        th, dth, slip = self._theta, self._dtheta, self._slip
-        for eq in self._rub_equilibria():  # (none when q0 != 0)
-            dev = rub_deviation(wf, eq, th, dth, E, slip, QUAD_TOL)
-            if dev is None:
-                continue
-            lin = LinearRub.admit(wf, eq, th, dth, slip, dev)
-            if lin is None:
-                lin = QuadraticRub.admit(wf, eq, th, dth, slip, dev)
-            if lin is not None:
-                return lin
-        return None
 
     # ------------------------------------------------------------------ state (de)serialisation
 
