@@ -143,7 +143,7 @@ class FlightSteps:
         self._clear = False
         self._envelope_at = -math.inf
 
-    def _impact(self, t: float, z: complex, v_minus: complex, tally: StepReport) -> None:
+    def _impact(self, t: float, z: complex, v_minus: complex, rep: StepReport) -> None:
         p = self._p
         W = self._inputs[0]
         n = z / p.c_r
@@ -152,11 +152,11 @@ class FlightSteps:
         if plastic:
             r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)
         imp = Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t, r.stick, r.E_diss)
-        tally.impacts.append(imp)
-        tally.P_contact -= complex(r.P_n, r.P_t) * n
-        tally.P_n += r.P_n
-        tally.P_t += r.P_t
-        tally.E_diss += r.E_diss
+        rep.impacts.append(imp)
+        rep.P_contact -= complex(r.P_n, r.P_t) * n
+        rep.P_n += r.P_n
+        rep.P_t += r.P_t
+        rep.E_diss += r.E_diss
         self._n_impacts += 1
         self._t_last, self._v_last = t, r.rdot
         self._z, self._v = z, r.v_plus

@@ -197,14 +197,14 @@ class Sliding:
             gn, sv = self.events(y_new, u + step)
             if gn <= 0.0 or sv <= 0.0:
                 x, y_ev, kind = self._locate(u, y, f0, step, k, tally)
-                self._tally(tally, y_ev, u + x)
+                self._store_integrals(tally, y_ev, u + x)
                 return SegmentEnd(u + x, y_ev[0], y_ev[1], kind, tally, H)
             tally.peak = max(tally.peak, gn)
             u_next = u + step if step < rem - u else rem
             u, y = u_next, y_new
             if not cut:  # a cut step says nothing about the step the motion allows
                 H = min(gbs.next_step_size(step, err, k), self.h_max)
-        self._tally(tally, y, rem)
+        self._store_integrals(tally, y, rem)
         return SegmentEnd(rem, y[0], y[1], None, tally, H)
 
     def _step_scale(self, rates: tuple[float, ...], step: float, y: list[float]) -> list[float]:
@@ -221,7 +221,7 @@ class Sliding:
             rates[3] * step + RTOL * abs(y[5]) + SCALE_FLOOR,
         ]
 
-    def _tally(self, tally: ContactTally, y: list[float], u: float) -> None:
+    def _store_integrals(self, tally: ContactTally, y: list[float], u: float) -> None:
         tally.I_n = y[2]
         tally.I_c = self.contact_impulse(y, u)
         tally.I_t = self.mus * y[2]
