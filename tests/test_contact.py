@@ -224,7 +224,7 @@ def test_spin_reversal_while_sliding_keeps_the_whirl() -> None:
                                           (-5.0e5j, 0.0, 1.0)])
 def test_fused_sliding_sweep_is_the_generic_midpoint_rule(q0: complex, mu: float,
                                                           slip: float) -> None:
-    """Sliding.sweep is a fused copy of gbs.midpoint on Sliding.rhs: bit-identical, so the
+    """Sliding.midpoint_sweep is a fused copy of gbs.midpoint on Sliding.rhs: bit-identical, so the
     sliding integrator is the documented modified-midpoint extrapolation, only faster."""
     wf = WallForces(q0=q0, eu=2.1e5 * cmath.exp(0.7j), beta=36.8, kappa=3.4e4,
                     Omega=W0, wr=1.2e3, mu=mu)
@@ -235,7 +235,8 @@ def test_fused_sliding_sweep_is_the_generic_midpoint_rule(q0: complex, mu: float
         f0 = sl.rhs(0.37, y0)
         for n in gbs.SEQUENCE:
             for H in (1e-6, 3e-4, 2e-3):
-                assert sl.sweep(0.37, y0, f0, H, n) == gbs.midpoint(sl.rhs, 0.37, y0, f0, H, n)
+                fused = sl.midpoint_sweep(0.37, y0, f0, H, n)
+                assert fused == gbs.midpoint(sl.rhs, 0.37, y0, f0, H, n)
 
 
 def test_extrapolation_error_ratio_is_nan_when_any_component_is() -> None:
@@ -274,7 +275,7 @@ def test_closed_form_rub_steps_agree_with_integrating_the_sliding(t_start: float
         assert abs(a.F_contact - b.F_contact) <= 1e-13 * abs(b.F_contact)
         assert abs(core.z - twin.z) <= 1e-13 * core.params.c_r
         assert abs(core.v - twin.v) <= 1e-13 * abs(twin.v)
-    assert core._locked == locked
+    assert core.state.locked == locked
 
 
 def test_linearised_rub_is_refused_outside_its_error_budget() -> None:
@@ -284,21 +285,21 @@ def test_linearised_rub_is_refused_outside_its_error_budget() -> None:
     slip sign."""
     core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
     _run(core, 0.2, 1e-3)
-    assert core._linear_rub(core._phasor()) is None
+    assert core._linear_rub(cmath.exp(1j * core.state.psi)) is None
     _run(core, 0.3, 1e-3)
-    E = core._phasor()
-    stable = next(e for e in forward_rub_equilibria(core._wf) if e.stable)
-    assert LinearRub.near(core._wf, stable, core._theta, core._dtheta, E, core._slip) is None
+    st, E = core.state, cmath.exp(1j * core.state.psi)
+    stable = next(e for e in forward_rub_equilibria(core.wall_forces) if e.stable)
+    assert LinearRub.near(core.wall_forces, stable, st.theta, st.dtheta, E, st.slip) is None
     assert isinstance(core._linear_rub(E), QuadraticRub)
     _run(core, 0.45, 1e-3)
-    E = core._phasor()
+    st, E = core.state, cmath.exp(1j * core.state.psi)
     assert core._linear_rub(E) is not None
-    wf = core._wf
+    wf = core.wall_forces
     stable, saddle = sorted(forward_rub_equilibria(wf), key=lambda e: not e.stable)
-    assert LinearRub.near(wf, saddle, core._theta, core._dtheta, E, core._slip) is None
-    assert LinearRub.near(wf, stable, core._theta, core._dtheta, E, -core._slip) is None
-    for eq, slip in ((saddle, core._slip), (stable, -core._slip)):
-        assert QuadraticRub.near(wf, eq, core._theta, core._dtheta, E, slip) is None
+    assert LinearRub.near(wf, saddle, st.theta, st.dtheta, E, st.slip) is None
+    assert LinearRub.near(wf, stable, st.theta, st.dtheta, E, -st.slip) is None
+    for eq, slip in ((saddle, st.slip), (stable, -st.slip)):
+        assert QuadraticRub.near(wf, eq, st.theta, st.dtheta, E, slip) is None
 
 
 def _sliding_impulse_case(case: str) -> tuple[TouchdownCore, complex, float]:

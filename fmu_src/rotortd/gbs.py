@@ -14,7 +14,7 @@ Vector = list[float]
 Rhs = Callable[[float, Sequence[float]], Vector]
 Sweep = Callable[[float, Sequence[float], Sequence[float], float, int], Vector]
 """A modified-midpoint sweep (u0, y0, f0, H, n) -> y(u0 + H): ``midpoint`` with its right-hand
-side bound, or a caller's fused copy of it (contact.Sliding.sweep)."""
+side bound, or a caller's fused copy of it (contact.Sliding.midpoint_sweep)."""
 
 SEQUENCE = (2, 4, 6, 8, 10, 12, 14, 16, 18)
 """Substep counts of the modified midpoint rule (the 'double harmonic' sequence)."""

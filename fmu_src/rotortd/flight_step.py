@@ -1,0 +1,192 @@
+"""Free flight, the contact search and impacts: the flight segments of TouchdownCore.
+
+Frame and units: inertial, SI. A mixin of ``simulator.TouchdownCore`` (it uses the core's
+attributes; see there).
+
+Low-speed rule (when an impact becomes sustained contact). At an impact with normal speed
+v, let A > 0 be the outward normal acceleration the contact-free forces give at the wall
+(the rotor would come back), v_b = d v the rebound speed, h_b = v_b^2/(2A) the rebound
+height and tau_b = 2 v_b/A its flight time. The impact is made plastic and sustained
+contact begins when
+
+  (1) h_b <= ETA_HEIGHT c_r (the remaining chattering cascade is below resolution), or
+  (2) the cascade to (1) would need more than N_CASCADE further impacts (d close to 1,
+      or d = 1 where it never ends) and the bounce is short, tau_b <= ETA_TIME/w_ref,
+      w_ref = max(|Omega|, |theta'|, sqrt(kappa), beta, sqrt(A/c_r)).
+
+Rule (1) replaces a cascade with total normal momentum m(1+d)v/(1-d) by a plastic impact
+m v plus sliding, which delivers the rest in the accumulation time 2 d v/((1-d) A): the
+same momentum and friction impulse, so the state after the accumulation point is off by
+O(h_b) in position and O(v_b^2/((1-d)A c_r)) in phase. Rule (2) replaces bounces of height
+at most ETA_TIME^2 c_r/8 by sliding; the bounce energy 1/2 m v_b^2 (which d < 1 would
+dissipate later, d = 1 never) is dissipated at once. Neither threshold depends on the
+communication step.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+from .events import ContactLocator, flight_is_clear
+from .flight import FlightModel
+from .impact import Impact, reset
+from .report import StepContext, StepReport
+from .scaled import TWO_PI_HI, TWO_PI_LO
+
+ETA_HEIGHT = 1e-14
+"""Rule (1): rebound height below ETA_HEIGHT c_r counts as contact."""
+ETA_TIME = 1e-3
+"""Rule (2): rebound flight time below ETA_TIME / w_ref counts as contact (long cascades)."""
+N_CASCADE = 1000
+"""Rule (2) applies when more than N_CASCADE impacts would remain before rule (1)."""
+_R_CLEAR = 1.0 - 1e-9
+
+
+class FlightSteps:
+    """Free flight and impacts (mixin of TouchdownCore)."""
+
+    def _proved_free_step(self, h: float, rep: StepReport) -> bool:
+        """A free step proved contact-free without a search: by the envelope for all time
+        under the held inputs (``_clear``), or by the cubic bound of ``flight_is_clear`` over
+        the whole step. Then one closed-form propagation, nothing to tally; else None (the
+        caller searches). Either way the step ends in the same state as a search that finds
+        nothing, which also propagates once from the start. True when taken."""
+        fm = self._fm
+        E = self._phasor()
+        work = 1
+        if not self._clear:
+            if self._on_wall:
+                return False
+            if self._t >= self._envelope_at:
+                work += 1
+                self._check_envelope(fm, self._t, E)
+            if not self._clear:
+                work += 1
+                if not flight_is_clear(fm, self._z, self._v, E, h):
+                    return False
+        self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
+        self._advance_psi(h)
+        self._on_wall = False
+        rep.work = work
+        return True
+
+    def _phasor(self) -> complex:
+        return cmath.exp(1j * self._psi)
+
+    def _advance_psi(self, ds: float) -> None:
+        x = self._psi + self._inputs[0] * ds
+        k = math.floor((x + math.pi) / TWO_PI_HI)
+        if k:
+            x = (x - k * TWO_PI_HI) - k * TWO_PI_LO
+            self._turns += k
+        self._psi = x
+
+    def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
+                      st: StepContext) -> float:
+        fm = self._fm
+        work = st.work
+        rem = (h - s) - st.s_lo
+        E = self._phasor()
+        if not self._clear and not self._on_wall and t0 + s >= self._envelope_at:
+            work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
+            self._check_envelope(fm, t0 + s, E)
+        hit = loc = None
+        if not self._clear:
+            loc = ContactLocator(fm, self._z, self._v, E)
+            hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
+        if hit is None:
+            if loc is not None and s > 0.0:
+                # the rest of a step after an event: a length that will not recur, whose
+                # flight map costs twelve times the search's modal state (measured)
+                self._z, self._v, _ = loc.state(rem, work)
+            else:  # a whole step: its length recurs and its flight map is cached
+                work.evals += 1
+                self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
+            self._advance_psi(rem)
+            self._on_wall = False
+            return h
+        ds = min(hit.s, rem)
+        self._advance_psi(ds)
+        if hit.kind == "clear":
+            self._z, self._v = hit.z, hit.v
+            self._on_wall = False
+            return st.later(s, ds)
+        z = hit.z * (self._p.c_r / abs(hit.z))
+        self._forget_clear_proof()
+        if hit.kind == "impact":
+            self._impact(t0 + s + (st.s_lo + ds), z, hit.v, rep)
+        else:
+            self._z, self._v = z, hit.v
+            self._enter_contact()
+        return st.later(s, ds)
+
+    def _check_envelope(self, fm: FlightModel, t: float, E: complex) -> None:
+        """Try to prove the flight clear of the wall for all time under the held inputs
+        (``_clear``). If that fails, schedule the next try for when the transient bound,
+        decaying like e^{-decay_rate t}, could have fallen below the margin left by the
+        steady whirl; never, if the steady whirl alone reaches the wall. The schedule only
+        saves work: a flight that is not proved clear is searched, which is always exact.
+        Not tried from the wall (after an impact or lift-off): sup |z| >= |z(0)| = c_r there,
+        so the proof must fail; the next step that starts off the wall tries again."""
+        steady, transient = fm.radius_bound_parts(self._z, self._v, E)
+        limit = self._p.c_r * _R_CLEAR
+        if steady + transient < limit:
+            self._clear = True
+        elif steady < limit and fm.decay_rate > 0.0 and math.isfinite(transient):
+            self._envelope_at = t + math.log(transient / (limit - steady)) / fm.decay_rate
+        else:
+            self._envelope_at = math.inf
+
+    def _forget_clear_proof(self) -> None:
+        """Forget the envelope proof: the state jumped or the inputs changed."""
+        self._clear = False
+        self._envelope_at = -math.inf
+
+    def _impact(self, t: float, z: complex, v_minus: complex, rep: StepReport) -> None:
+        p = self._p
+        W = self._inputs[0]
+        n = z / p.c_r
+        r = reset(n, v_minus, p.m, p.d, p.mu, p.R, W)
+        plastic = self._low_speed_contact(n, r.rdot, r.v_plus)
+        if plastic:
+            r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)
+        imp = Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t, r.stick, r.E_diss)
+        rep.impacts.append(imp)
+        rep.P_contact -= complex(r.P_n, r.P_t) * n
+        rep.P_n += r.P_n
+        rep.P_t += r.P_t
+        rep.E_diss += r.E_diss
+        self._n_impacts += 1
+        self._t_last, self._v_last = t, r.rdot
+        self._z, self._v = z, r.v_plus
+        self._on_wall = True
+        if plastic:
+            A = self._outward_accel(n, r.v_plus)
+            d = p.d
+            self._t_contact = t + (2.0 * d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)
+            self._enter_contact()
+
+    def _outward_accel(self, n: complex, v: complex) -> float:
+        """A (m/s^2): outward normal acceleration at the wall from contact-free forces."""
+        wf = self._wf
+        vt = (n.conjugate() * v).imag
+        gn, _ = wf.gn_gt(cmath.phase(n), vt / self._p.c_r, self._phasor())
+        return gn * self._p.c_r
+
+    def _low_speed_contact(self, n: complex, v: float, v_plus: complex) -> bool:
+        """The low-speed rule of the module docstring: does this impact start contact?"""
+        p = self._p
+        A = self._outward_accel(n, v_plus)
+        if A <= 0.0:
+            return False
+        vb = p.d * v
+        if vb * vb <= 2.0 * A * ETA_HEIGHT * p.c_r:
+            return True
+        v1 = math.sqrt(2.0 * A * ETA_HEIGHT * p.c_r)
+        if p.d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
+            return False
+        wf = self._wf
+        vt = (n.conjugate() * v_plus).imag
+        w_ref = max(wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
+        return 2.0 * vb / A <= ETA_TIME / w_ref

@@ -1,0 +1,120 @@
+"""What one step of TouchdownCore reports, and the context of a step taken segment by segment.
+
+Frame and units: inertial, SI. ``StepReport`` is the step's one accumulator and its result;
+``StepContext`` holds the step-scoped flags and the work count, passed down the step loop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+from .events import WORK_MAX, Work
+from .impact import Impact
+from .wall import ContactTally
+
+MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
+STATUS_OK, STATUS_WORK_CAP = 0, 1
+_MODE_NAMES = {MODE_FREE: "lift_off", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
+
+
+class WorkCapExceeded(RuntimeError):
+    """A step exceeded its work cap."""
+
+
+@dataclass(slots=True)
+class StepReport:
+    """What happened in one step (SI, inertial). Forces are step averages (impulse/h).
+
+    Also the step's accumulator: while the step runs, impacts and contact segments add
+    their impulses to P_contact, P_n, P_t, E_diss and F_n_peak (the contact force's peak;
+    the impacts' P_n/h join it at the end), and the step's end turns the impulses into the
+    averages F_contact, F_n and T_f (``TouchdownCore._finish``)."""
+
+    status: int = STATUS_OK
+    message: str = ""
+    impacts: list[Impact] = field(default_factory=list)
+    F_contact: complex = 0j
+    F_n: float = 0.0
+    F_n_peak: float = 0.0
+    P_n: float = 0.0
+    T_f: float = 0.0
+    E_diss: float = 0.0
+    mode: int = MODE_FREE
+    work: int = 0
+    work_cap: int = 0
+    transitions: list[tuple[float, str]] = field(default_factory=list)
+    """Mode changes in the step: (t, "sliding" | "rolling" | "lift_off")."""
+    P_contact: complex = 0j
+    """Impulse of the contact on the rotor over the step (N s): F_contact = P_contact/h."""
+    P_t: float = 0.0
+    """Signed friction impulse (N s): T_f = -R P_t/h."""
+
+    def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
+        """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
+        self.P_contact += mc * tal.I_c
+        self.P_n += mc * tal.I_n
+        self.P_t += mc * tal.I_t
+        self.E_diss += mc * c_r * tal.I_e
+        self.F_n_peak = max(self.F_n_peak, mc * tal.peak)
+
+
+class Kinematics(NamedTuple):
+    """Outputs derived from the state (SI; u_*, du_* scaled co-rotating, t = Omega tau).
+
+    x, y (m), vx, vy (m/s), r_rel = |z|/c_r, u = z e^{-i psi}/c_r, du = dU/dt (0 when
+    Omega = 0), psi_wrapped (rad, (-pi, pi]), whirl_rate theta' (rad/s, inertial),
+    v_rel = R Omega + c_r theta' (m/s), F_amb = a (F_bias - c v - k z) (N). A named tuple:
+    the fields unpack in this order.
+    """
+
+    x: float
+    y: float
+    vx: float
+    vy: float
+    r_rel: float
+    u_re: float
+    u_im: float
+    du_re: float
+    du_im: float
+    psi_wrapped: float
+    whirl_rate: float
+    v_rel: float
+    F_amb_x: float
+    F_amb_y: float
+
+
+class StepContext:
+    """The context of a step taken segment by segment, passed down the step loop and
+    never stored on the core: its work and work bound, the rounding error of its local
+    time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
+
+    __slots__ = ("cap", "roll_lenient", "rub_refused", "s_lo", "sticky_at", "work")
+
+    def __init__(self, cap: int, rub_refused: bool = False) -> None:
+        self.work = Work()
+        self.cap = cap  # work bound (units)
+        self.s_lo = 0.0  # rounding error of the step-local time (later), s
+        self.roll_lenient = False  # zero slip proved stuck (_transition)
+        self.sticky_at = math.nan  # where flight and contact swapped at N = 0
+        self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
+
+    def later(self, s: float, ds: float) -> float:
+        """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step
+        of many events would otherwise drift by one rounding per event."""
+        t = s + ds
+        r = t - s
+        self.s_lo += (s - (t - r)) + (ds - r)
+        return t
+
+
+def work_cap(*_args: object) -> int:
+    """The work bound of one step (units): the constant WORK_MAX, whatever the scene and
+    the step length (docs/model.md 7). The arguments (parameters, h, Omega, F_ext, amb_on,
+    speed, as the former rate-based cap took them) are accepted and ignored."""
+    return WORK_MAX
+
+
+_SEGMENT_NAMES = {MODE_FREE: "free flight", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
+_PROVED_FREE, _RUB = "proved free flight", "rub in closed form"  # _whole_step's choices

@@ -1,0 +1,137 @@
+"""The wall's forces and what every contact segment shares (MODEL.md eq. (3)).
+
+Frame and units: inertial, SI; forces per unit m c_r (1/s^2), as in ``rotortd.contact``'s
+docstring. WallForces: the contact-free forces at the wall under held inputs.
+ContactTally: a segment's contact integrals. SegmentEnd: what every contact segment's
+``run(rem, limit)`` returns.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import dataclass, field
+
+from .divdiff import dd2
+from .events import G2_FLOOR
+from .params import RotorParams
+
+
+class ContactWorkExceeded(RuntimeError):
+    """A contact segment hit its work cap; ``work`` is what it had used."""
+
+    def __init__(self, message: str, work: int = 0) -> None:
+        super().__init__(message)
+        self.work = work
+
+
+def phase_integral(nu: float, x: float) -> complex:
+    """int_0^x e^{i nu u} du (s), accurate for nu -> 0."""
+    return x * dd2(1j * nu * x, 0j)
+
+
+@dataclass(frozen=True)
+class WallForces:
+    """Contact-free forces at the wall per unit m c_r (1/s^2), inertial frame, held inputs."""
+
+    q0: complex
+    eu: complex
+    beta: float
+    kappa: float
+    Omega: float
+    wr: float
+    mu: float
+    gn_floor: float = 0.0
+    """Absolute part of Gn's rounding band (1/s^2): the underflow error of subnormal
+    forces. A quarter of the free flight's band of g'' = 2 c_r^2 Gn (events.G2_FLOOR)."""
+
+    @classmethod
+    def build(cls, p: RotorParams, Omega: float, F_ext: complex, amb: float) -> WallForces:
+        """Forces for parameters ``p`` and the inputs held over a step."""
+        mc = p.m * p.c_r
+        return cls(
+            q0=(amb * p.bias_force + p.gravity_force + complex(F_ext)) / mc,
+            eu=p.e_c * Omega * Omega * cmath.exp(1j * p.phi) / p.c_r,
+            beta=amb * p.c / p.m,
+            kappa=amb * p.k / p.m,
+            Omega=Omega,
+            wr=p.R * Omega / p.c_r,
+            mu=p.mu,
+            gn_floor=G2_FLOOR / (8.0 * p.c_r * p.c_r),
+        )
+
+    def gn_gt(self, theta: float, dtheta: float, E: complex) -> tuple[float, float]:
+        """(Gn, Gt) in 1/s^2 at angle theta, whirl rate dtheta and phasor E = e^{i psi}."""
+        Q = self.q0 + self.eu * E
+        co, sn = math.cos(theta), math.sin(theta)  # P = Q e^{-i theta}, as real parts:
+        return ((Q.real * co + Q.imag * sn) - self.kappa + dtheta * dtheta,
+                (Q.imag * co - Q.real * sn) - self.beta * dtheta)
+
+    def gn_rate(self, theta: float, dtheta: float, E: complex, ddtheta: float) -> float:
+        """dGn/dt (1/s^3) along a contact motion with angular acceleration ddtheta."""
+        w = complex(math.cos(theta), -math.sin(theta))
+        Q = self.q0 + self.eu * E
+        dP = (1j * self.Omega * self.eu * E - 1j * dtheta * Q) * w
+        return dP.real + 2.0 * dtheta * ddtheta
+
+    def cone_margin(self, theta: float, dtheta: float, E: complex) -> tuple[float, float]:
+        """(mu Gn - |Gt|, its rate along rolling) in 1/s^2 and 1/s^3: rolling holds while > 0."""
+        gn, gt = self.gn_gt(theta, dtheta, E)
+        w = complex(math.cos(theta), -math.sin(theta))
+        dP = (1j * self.Omega * self.eu * E - 1j * dtheta * (self.q0 + self.eu * E)) * w
+        rate = self.mu * (dP.real) - math.copysign(1.0, gt) * dP.imag
+        return self.mu * gn - abs(gt), rate
+
+    def gn_tol(self, dtheta: float) -> float:
+        """Rounding band of Gn (1/s^2): inside it the sign of dGn/dt decides lift-off."""
+        return 64.0 * 2.220446049250313e-16 * self.force_scale(dtheta) + self.gn_floor
+
+    def force_scale(self, dtheta: float) -> float:
+        """|q0| + |eu| + kappa + theta'^2 (1/s^2): the size of the terms of Gn and Gt."""
+        return abs(self.q0) + abs(self.eu) + self.kappa + dtheta * dtheta
+
+    def omega_ref(self, dtheta: float) -> float:
+        """A frequency scale (rad/s) of the contact motion, for step limits and tolerances."""
+        return max(
+            abs(self.Omega),
+            abs(dtheta),
+            math.sqrt(self.kappa),
+            self.beta,
+            math.sqrt(abs(self.q0) + abs(self.eu)),
+            1e-6,
+        )
+
+
+@dataclass
+class ContactTally:
+    """Integrals of the contact force over a segment, per unit m c_r (SI otherwise).
+
+    I_n = int Gn (1/s), I_c = int of the contact force on the rotor / (m c_r) (complex,
+    1/s), I_t = int Ft (1/s), I_e = int Ft (wr + theta') (1/s^2; times m c_r^2 gives J),
+    peak = max Gn seen (1/s^2).
+    """
+
+    I_n: float = 0.0
+    I_c: complex = 0j
+    I_t: float = 0.0
+    I_e: float = 0.0
+    peak: float = 0.0
+    work: int = 0
+
+
+@dataclass
+class SegmentEnd:
+    """Where a contact segment stopped: after ``duration`` seconds, state, and the event.
+
+    Every contact segment (Sliding, Rolling, LinearRub, QuadraticRub, LockedRub) returns
+    one from ``run(rem, limit)``: advance at most ``rem`` seconds, at most ``limit`` work
+    units, and stop at the first event."""
+
+    duration: float
+    """Length of the segment (s), from its start to its end or event."""
+    theta: float
+    dtheta: float
+    event: str | None  # None (end), "lift_off", "slip_zero", "slip_stuck", "cone"
+    tally: ContactTally = field(default_factory=ContactTally)
+    next_step: float = math.inf
+    """Sliding only: the integrator's step size (s) for the next sliding segment."""
