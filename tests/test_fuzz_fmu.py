@@ -83,6 +83,64 @@ def test_refusal_kinds(status: int, phase: str, message: str, kind: str) -> None
     assert fuzz_fmu.violations(res, 5.0) == expected
 
 
+FAKE_CHILD = """
+import json, os, signal, sys
+specs = json.loads(sys.stdin.read())
+for spec in specs:
+    how = spec["params"].get("how")
+    if how == "segv":
+        os.kill(os.getpid(), signal.SIGSEGV)
+    res = {"id": spec["id"], "statuses": [0], "max_step_wall": 0.0}
+    if how == "hang":
+        res["abandoned"] = res["slow_step"] = {"op": 0, "h": 1.0, "wall": 9.0}
+        print("CASE " + json.dumps(res), flush=True)
+        os._exit(3)
+    print("CASE " + json.dumps(res), flush=True)
+    if how == "batch_only" and len(specs) > 1:
+        os._exit(1)
+os._exit(0)
+"""
+
+
+def _fake_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, hows: list[str]
+              ) -> fuzz_fmu.Collected:
+    child = tmp_path / "child.py"
+    child.write_text(FAKE_CHILD, encoding="utf-8")
+    monkeypatch.setattr(fuzz_fmu, "CASE_SCRIPT", child)
+    specs = [{"id": i, "params": {"how": how}, "ops": []} for i, how in enumerate(hows)]
+    return fuzz_fmu.Runner(str(tmp_path), fuzz_fmu.Limits(timeout=60.0), 2).run(specs, 4)
+
+
+def test_runner_attributes_a_crash_to_its_case(tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    got = _fake_run(tmp_path, monkeypatch, ["", "", "segv", "", "", ""])
+    assert sorted(got.results) == list(range(6))
+    assert [c["id"] for c in got.crashes] == [2] and got.crashes[0]["scope"] == "alone"
+    assert got.batch_failures == 1 and got.reruns == 4  # the first batch of 4, case by case
+    assert [i for i, r in got.results.items() if r.get("crash")] == [2]
+
+
+def test_runner_counts_a_crash_seen_only_in_the_batch(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    got = _fake_run(tmp_path, monkeypatch, ["", "batch_only", ""])
+    assert sorted(got.results) == [0, 1, 2] and got.reruns == 3
+    assert len(got.crashes) == 1 and got.crashes[0]["ids"] == [0, 1, 2]
+    assert got.crashes[0]["scope"].startswith("batch only")
+    report = fuzz_fmu.summarise([{"id": i, "params": {}} for i in range(3)], got,
+                                fuzz_fmu.Limits())
+    assert report["counts"]["crash"] == 1
+
+
+def test_runner_continues_after_an_abandoned_step(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    got = _fake_run(tmp_path, monkeypatch, ["", "hang", "", "", "", "hang", ""])
+    assert sorted(got.results) == list(range(7)) and not got.crashes
+    assert got.batch_failures == 0
+    slow = [i for i, r in got.results.items()
+            if "over_step_limit" in fuzz_fmu.violations(r, 5.0)]
+    assert slow == [1, 5]
+
+
 # ---------------------------------------------------------------------------- slow
 @pytest.fixture(scope="module")
 def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:

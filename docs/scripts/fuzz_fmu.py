@@ -635,7 +635,11 @@ def summarise(specs: list[dict[str, Any]], got: Collected, limits: Limits
             sig = signature(kind, res, spec)
             g = groups.setdefault(sig, {"kind": kind, "signature": sig, "ids": []})
             g["ids"].append(cid)
-    counts["crash"] += sum(1 for c in got.crashes if c["scope"] != "alone")
+    for crash in got.crashes:
+        if crash["scope"] != "alone":  # no case of the batch crashes on its own
+            counts["crash"] += 1
+            sig = f"crash: {crash['scope']} (rc={crash['rc']}, timeout={crash['timed_out']})"
+            groups.setdefault(sig, {"kind": "crash", "signature": sig, "ids": crash["ids"]})
     return {"counts": dict(counts), "refusal_kinds": dict(refusals),
             "groups": sorted(groups.values(), key=lambda g: (VIOLATIONS.index(g["kind"]),
                                                              -len(g["ids"])))}
