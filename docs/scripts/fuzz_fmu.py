@@ -43,7 +43,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
-from fuzz_fmu_case import HUNG_RC  # noqa: E402 (docs/scripts/fuzz_fmu_case.py)
+from fuzz_fmu_case import HUNG_RC, RADIUS_TOL  # noqa: E402 (docs/scripts/fuzz_fmu_case.py)
 from mdblock import replace_block  # noqa: E402 (docs/scripts/mdblock.py)
 
 CASE_SCRIPT = HERE / "fuzz_fmu_case.py"
@@ -53,7 +53,7 @@ DEFAULT_DOC = ROOT / "docs" / "fuzz.md"
 
 OPEN_DECADES = 3.0   # an undeclared bound is drawn as |start| * 10**3 (10**3 if start = 0)
 LOG_DECADES = 9.0    # a range from 0 is drawn log-uniform down to 1e-9 of its top
-RADIUS_TOL = 1e-12   # |(x, y)| <= c_r (1 + RADIUS_TOL) after every OK step
+POSITION = ("x0", "y0", "c_r")  # drawn together: the initial position inside the clearance
 WORK_BOUND_RE = re.compile(r"work[\s_-]*(bound|cap|budget|limit)", re.IGNORECASE)
 CROSS_RE = re.compile(r"cross-parameter", re.IGNORECASE)
 NUMBER_RE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|\b(?:inf|nan)\b")
@@ -65,7 +65,7 @@ VIOLATION_TITLES = {
     "over_step_limit": "steps over the step limit",
     "nonfinite_ok": "non-finite outputs with OK",
     "declared_valid_refusal": "refusals of declared-valid input",
-    "outside_clearance": "|z| > c_r (1 + 1e-12) after OK",
+    "outside_clearance": f"|z| > c_r (1 + {RADIUS_TOL:g}) after OK",
     "state_roundtrip": "state round trips not bit-identical",
 }
 
@@ -289,7 +289,7 @@ def draw_case(model: ModelInfo, seed: int, index: int) -> dict[str, Any]:
     rng = random.Random(f"fuzz-fmu:{seed}:{index}")
     style = rng.choices(STYLES, STYLE_WEIGHTS)[0]
     params = {v.name: draw_value(rng, v, style) for v in model.named("parameter")}
-    if {"x0", "y0", "c_r"} <= params.keys():
+    if set(POSITION) <= params.keys():
         params.update(draw_position(rng, model, params["c_r"]))
     params.update({v.name: draw_value(rng, v, style) for v in model.named("input")})
     ops = draw_ops(rng, model, style)
@@ -563,19 +563,22 @@ class Shrinker:
                 {**spec, "roundtrips": [], "ops": bare[-1:]}]
 
     def _params(self, spec: dict[str, Any]) -> dict[str, Any]:
-        """ddmin over the parameters that differ from their start values."""
+        """ddmin over the parameters that differ from their start values; the initial
+        position and the clearance go together (alone, either could leave the disc)."""
         start = {k: self.model.vars[k].start for k in spec["params"]}
-        keep = [k for k, v in spec["params"].items() if v != start[k]]
+        changed = [k for k, v in spec["params"].items() if v != start[k]]
+        coupled = [n for n in POSITION if n in changed]
+        units = [[k] for k in changed if k not in coupled] + ([coupled] if coupled else [])
 
-        def with_only(names: list[str]) -> dict[str, Any]:
+        def with_only(kept: list[list[str]]) -> dict[str, Any]:
+            names = {k for unit in kept for k in unit}
             params = {k: (v if k in names else start[k]) for k, v in spec["params"].items()}
             return {**spec, "params": params}
 
-        keep = ddmin(keep, lambda names: self.still(with_only(names)))
-        return with_only(keep)
+        return with_only(ddmin(units, lambda kept: self.still(with_only(kept))))
 
 
-def ddmin(items: list[str], test: Any) -> list[str]:
+def ddmin(items: list[Any], test: Any) -> list[Any]:
     """Zeller's delta debugging: a 1-minimal sublist for which test() holds (test(items)
     is assumed true)."""
     n = 2
@@ -659,11 +662,9 @@ def run_stats(got: Collected) -> dict[str, Any]:
 
 
 def _compact(res: dict[str, Any]) -> dict[str, Any]:
-    """A failing case's result for the JSON file: the messages cut to the first three
-    (the refusal keeps its own)."""
-    out = {k: v for k, v in res.items() if k not in ("id", "messages")}
-    out["first_messages"] = res.get("messages", [])[:3]
-    return out
+    """A failing case's result for the JSON file, without its message log (the refusal
+    keeps its own messages)."""
+    return {k: v for k, v in res.items() if k not in ("id", "messages")}
 
 
 def write_results(report: dict[str, Any], path: Path) -> None:
@@ -685,7 +686,7 @@ class FuzzConfig:
     batch_size: int = 50
     limits: Limits = field(default_factory=Limits)
     shrink_trials: int = 0
-    shrink_seconds: float = 240.0
+    shrink_seconds: float = 300.0
     progress: bool = False
 
 
@@ -822,9 +823,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                    help="a single doStep longer than this (wall time, s) is a violation")
     p.add_argument("--abandon", type=float, default=None,
                    help="abandon a doStep still running after this (s; default limit + 0.5)")
-    p.add_argument("--shrink-trials", type=int, default=40,
+    p.add_argument("--shrink-trials", type=int, default=60,
                    help="runs spent shrinking each cause group's example (0: none)")
-    p.add_argument("--shrink-seconds", type=float, default=240.0)
+    p.add_argument("--shrink-seconds", type=float, default=300.0)
     p.add_argument("--out", default=str(DEFAULT_OUT), help="results JSON ('' : none)")
     p.add_argument("--doc", default=str(DEFAULT_DOC), help="page with the fuzz block ('': none)")
     p.add_argument("--check", action="store_true", help="exit 1 unless every count is 0")

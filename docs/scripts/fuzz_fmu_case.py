@@ -45,7 +45,7 @@ HUNG_RC = 3            # exit code of a process whose watchdog abandoned a doSte
 MAX_MESSAGES = 40      # messages kept per case (the first ones, then the last ones)
 MAX_MESSAGE_CHARS = 600
 OK_STATUSES = (0, 1)   # fmi2OK, fmi2Warning: the step's outputs are valid
-STATUS_NAMES = ("ok", "warning", "discard", "error", "fatal", "pending")
+RADIUS_TOL = 1e-12     # |(x, y)| <= c_r (1 + RADIUS_TOL) after every OK step
 
 
 # ---------------------------------------------------------------------------- results
@@ -234,7 +234,7 @@ class CaseRun:
             excess = math.hypot(out["x"], out["y"]) / self.c_r - 1.0
             if excess > self.res.max_excess:
                 self.res.max_excess = excess
-            if excess > 1e-12 and self.res.outside is None:
+            if excess > RADIUS_TOL and self.res.outside is None:
                 self.res.outside = {"phase": self.phase, "t": self.t, "excess": excess}
 
     # ------------------------------------------------------------ phases
