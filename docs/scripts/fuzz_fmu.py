@@ -759,7 +759,7 @@ def count_table(report: dict[str, Any]) -> str:
     lines = ["| count | value | required |", "|---|---|---|"]
     for k in VIOLATIONS:
         mark = "ok" if counts[k] == 0 else "**FAIL**"
-        lines.append(f"| {VIOLATION_TITLES[k]} | {counts[k]} | 0 ({mark}) |")
+        lines.append(f"| {_cell(VIOLATION_TITLES[k])} | {counts[k]} | 0 ({mark}) |")
     kinds = report["refusal_kinds"]
     for k in ("cross-parameter", "work-bound"):
         lines.append(f"| refusals: {k} (counted apart) | {kinds.get(k, 0)} | — |")
@@ -772,17 +772,26 @@ def group_table(report: dict[str, Any]) -> str:
     for g in report["groups"]:
         repro = g["reproducer"]
         params = ", ".join(f"{k}={_fmt(v)}" for k, v in repro["non_default"].items())
-        steps = ", ".join(_fmt(op["h"]) for op in repro["spec"]["ops"][:6])
+        steps = ", ".join(_fmt_op(op) for op in repro["spec"]["ops"][:6])
         if len(repro["spec"]["ops"]) > 6:
             steps += f", … ({len(repro['spec']['ops'])} steps)"
-        cause = g["signature"].replace("|", "\\|")
-        lines.append(f"| {g['kind']} | {g['n']} | {cause} | {g['example_id']} | "
-                     f"{params.replace('|', '/') or '—'} | {steps} |")
+        lines.append(f"| {g['kind']} | {g['n']} | {_cell(g['signature'])} | "
+                     f"{g['example_id']} | {_cell(params) or '—'} | {steps} |")
     return "\n".join(lines)
 
 
 def _fmt(v: Any) -> str:
     return f"{v:.6g}" if isinstance(v, float) else json.dumps(v)
+
+
+def _fmt_op(op: dict[str, Any]) -> str:
+    """A step as ``h`` or ``h (name=value set before it, ...)``."""
+    sets = ", ".join(f"{k}={_fmt(v)}" for k, v in op.get("set", {}).items())
+    return _fmt(op["h"]) + (f" ({sets})" if sets else "")
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")
 
 
 def doc_block(report: dict[str, Any]) -> str:
