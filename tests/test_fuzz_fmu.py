@@ -88,6 +88,9 @@ import json, os, signal, sys
 specs = json.loads(sys.stdin.read())
 for spec in specs:
     how = spec["params"].get("how")
+    if how == "sleep":
+        import time
+        time.sleep(60)
     if how == "segv":
         os.kill(os.getpid(), signal.SIGSEGV)
     res = {"id": spec["id"], "statuses": [0], "max_step_wall": 0.0}
@@ -102,13 +105,13 @@ os._exit(0)
 """
 
 
-def _fake_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, hows: list[str]
-              ) -> fuzz_fmu.Collected:
+def _fake_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, hows: list[str],
+              timeout: float = 60.0) -> fuzz_fmu.Collected:
     child = tmp_path / "child.py"
     child.write_text(FAKE_CHILD, encoding="utf-8")
     monkeypatch.setattr(fuzz_fmu, "CASE_SCRIPT", child)
     specs = [{"id": i, "params": {"how": how}, "ops": []} for i, how in enumerate(hows)]
-    return fuzz_fmu.Runner(str(tmp_path), fuzz_fmu.Limits(timeout=60.0), 2).run(specs, 4)
+    return fuzz_fmu.Runner(str(tmp_path), fuzz_fmu.Limits(timeout=timeout), 2).run(specs, 4)
 
 
 def test_runner_attributes_a_crash_to_its_case(tmp_path: Path,
@@ -129,6 +132,13 @@ def test_runner_counts_a_crash_seen_only_in_the_batch(tmp_path: Path,
     report = fuzz_fmu.summarise([{"id": i, "params": {}} for i in range(3)], got,
                                 fuzz_fmu.Limits())
     assert report["counts"]["crash"] == 1
+
+
+def test_runner_times_out_a_case_that_hangs(tmp_path: Path,
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    got = _fake_run(tmp_path, monkeypatch, ["", "sleep", ""], timeout=1.0)
+    assert sorted(got.results) == [0, 1, 2]
+    assert [(c["id"], c["timed_out"]) for c in got.crashes] == [(1, True)]
 
 
 def test_runner_continues_after_an_abandoned_step(tmp_path: Path,

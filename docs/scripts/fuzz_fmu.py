@@ -27,11 +27,13 @@ import hashlib
 import json
 import math
 import os
+import queue
 import random
 import re
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
@@ -302,7 +304,7 @@ def draw_case(model: ModelInfo, seed: int, index: int) -> dict[str, Any]:
 class Limits:
     step_limit: float = 5.0   # s: a single doStep above it is a violation
     abandon: float = 5.5      # s: a doStep still running then is abandoned (process exits)
-    timeout: float = 600.0    # s: wall-clock limit of one subprocess (batch or case)
+    timeout: float = 300.0    # s: wall-clock limit of one case in its subprocess
 
 
 @dataclass
@@ -327,27 +329,47 @@ class ProcOutcome:
 
 
 def run_process(unzipdir: str, specs: list[dict[str, Any]], limits: Limits) -> ProcOutcome:
-    """Run specs in one fresh interpreter (fuzz_fmu_case.py)."""
+    """Run specs in one fresh interpreter (fuzz_fmu_case.py), reading its results as they
+    come; the process is killed when one case takes longer than ``limits.timeout``."""
     cmd = [sys.executable, str(CASE_SCRIPT), unzipdir, repr(limits.step_limit),
            repr(limits.abandon)]
-    try:
-        proc = subprocess.run(cmd, input=json.dumps(specs), capture_output=True, text=True,
-                              timeout=limits.timeout)
-        out, err, rc, timed_out = proc.stdout, proc.stderr, proc.returncode, False
-    except subprocess.TimeoutExpired as exc:
-        out, err, rc, timed_out = _text(exc.stdout), _text(exc.stderr), None, True
-    results = {}
-    for line in out.splitlines():
+    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    lines: queue.Queue[str | None] = queue.Queue()
+    err: list[str] = []
+    threading.Thread(target=_pump, args=(proc.stdout, lines), daemon=True).start()
+    errors = threading.Thread(target=lambda: err.append(proc.stderr.read()), daemon=True)
+    errors.start()
+    with contextlib.suppress(BrokenPipeError):
+        proc.stdin.write(json.dumps(specs))
+        proc.stdin.close()
+    results, timed_out = _collect(lines, limits.timeout)
+    if timed_out:
+        proc.kill()
+    rc = proc.wait()
+    errors.join(timeout=10.0)
+    return ProcOutcome(results, None if timed_out else rc, timed_out, "".join(err)[-2000:])
+
+
+def _pump(stream: Any, lines: queue.Queue) -> None:
+    for line in stream:
+        lines.put(line)
+    lines.put(None)
+
+
+def _collect(lines: queue.Queue, timeout: float) -> tuple[dict[int, dict[str, Any]], bool]:
+    """The ``CASE`` results until the end of the output, or until a case overruns."""
+    results: dict[int, dict[str, Any]] = {}
+    while True:
+        try:
+            line = lines.get(timeout=timeout)
+        except queue.Empty:
+            return results, True
+        if line is None:
+            return results, False
         if line.startswith("CASE "):
             res = json.loads(line[5:])
             results[res["id"]] = res
-    return ProcOutcome(results, rc, timed_out, err[-2000:])
-
-
-def _text(data: bytes | str | None) -> str:
-    if isinstance(data, bytes):
-        return data.decode("utf-8", "replace")
-    return data or ""
 
 
 def _crash_record(spec: dict[str, Any], out: ProcOutcome, scope: str) -> dict[str, Any]:
@@ -826,8 +848,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--fmu", type=Path, default=DEFAULT_FMU)
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--batch-size", type=int, default=50)
-    p.add_argument("--timeout", type=float, default=600.0,
-                   help="wall-clock limit of one subprocess, a batch or a single case (s)")
+    p.add_argument("--timeout", type=float, default=300.0,
+                   help="wall-clock limit of one case (s): a batch is killed when the case "
+                        "it runs takes longer")
     p.add_argument("--step-limit", type=float, default=5.0,
                    help="a single doStep longer than this (wall time, s) is a violation")
     p.add_argument("--abandon", type=float, default=None,
