@@ -110,7 +110,11 @@ def _start(v: Any) -> Any:
     return str(v.start)
 
 
-def _bound(x: Any) -> float | None:
+def _bound(v: Any, key: str) -> float | None:
+    """The variable's min or max, else its declared type's (FMPy does not inherit them)."""
+    x = getattr(v, key)
+    if x is None and v.declaredType is not None:
+        x = getattr(v.declaredType, key, None)
     return None if x is None else float(x)
 
 
@@ -119,7 +123,7 @@ def load_model(fmu: Path) -> ModelInfo:
 
     md = read_model_description(str(fmu))
     variables = {v.name: Var(v.name, v.type, v.causality, v.variability, _start(v),
-                             _bound(v.min), _bound(v.max)) for v in md.modelVariables}
+                             _bound(v, "min"), _bound(v, "max")) for v in md.modelVariables}
     step = md.defaultExperiment.stepSize if md.defaultExperiment else None
     return ModelInfo(variables, float(step) if step else 1e-4)
 
