@@ -55,6 +55,7 @@ DEFAULT_DOC = ROOT / "docs" / "fuzz.md"
 
 OPEN_DECADES = 3.0   # an undeclared bound is drawn as |start| * 10**3 (10**3 if start = 0)
 LOG_DECADES = 9.0    # a range from 0 is drawn log-uniform down to 1e-9 of its top
+SLOW_MARGIN = 1.5    # a shrunk slow-step reproducer takes at least 1.5x the step limit
 POSITION = ("x0", "y0", "c_r")  # drawn together: the initial position inside the clearance
 WORK_BOUND_RE = re.compile(r"work[\s_-]*(bound|cap|budget|limit)", re.IGNORECASE)
 CROSS_RE = re.compile(r"cross-parameter", re.IGNORECASE)
@@ -552,12 +553,15 @@ class Shrinker:
     """Greedy reduction of a failing spec that keeps the failure's signature: ops after
     the failing one cut, state round trips and mid-run sets dropped, earlier ops dropped,
     then a 1-minimal set of non-default parameters (ddmin), within a trial and time budget.
-    Trials abandon a step just past the step limit (that is enough to reproduce it)."""
+    Trials abandon a step just past the step limit (that is enough to reproduce it); a slow
+    step must exceed SLOW_MARGIN times the limit, so that its reproducer stays slow on a
+    less loaded machine."""
 
     def __init__(self, kind: str, sig: str, model: ModelInfo, unzipdir: str, limits: Limits,
                  trials: int, budget_s: float) -> None:
         self.kind, self.sig, self.model, self.unzipdir = kind, sig, model, unzipdir
-        self.limits = Limits(limits.step_limit, limits.step_limit + 0.25, limits.timeout)
+        limit = limits.step_limit * (SLOW_MARGIN if kind == "over_step_limit" else 1.0)
+        self.limits = Limits(limit, limit + 0.25, limits.timeout)
         self.trials, self.deadline, self.used = trials, time.perf_counter() + budget_s, 0
 
     def spent(self) -> bool:
