@@ -87,16 +87,9 @@ print("RESULT:" + json.dumps(out))
 
 
 @pytest.fixture(scope="module")
-def rotor_fmu(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The RotorTouchdown FMU built by build.py (ROTORTD_FMU=path tests that FMU)."""
-    prebuilt = os.environ.get("ROTORTD_FMU")
-    if prebuilt:
-        return Path(prebuilt).resolve()
-    sys.path.insert(0, str(ROOT))
-    import build
-
-    spec = next(s for s in build.FMU_SPECS if s.name == "RotorTouchdown")
-    return build.build_fmu(spec, tmp_path_factory.mktemp("fmu"))
+def rotor_fmu(fmu_path: Path) -> Path:
+    """The RotorTouchdown FMU (tests/conftest.py: built by build.py, or ROTORTD_FMU)."""
+    return fmu_path
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="ELF exit order (Linux)")

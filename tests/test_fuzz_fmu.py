@@ -8,7 +8,6 @@ subprocesses; each of the counts must be 0. The quick tests check the harness it
 from __future__ import annotations
 
 import math
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -152,20 +151,6 @@ def test_runner_continues_after_an_abandoned_step(tmp_path: Path,
 
 
 # ---------------------------------------------------------------------------- slow
-@pytest.fixture(scope="module")
-def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """As tests/test_fmu.py: ROTORTD_FMU=path tests that FMU, else build.py's own function
-    builds one from the sources (python build.py writes models/RotorTouchdown.fmu)."""
-    prebuilt = os.environ.get("ROTORTD_FMU")
-    if prebuilt:
-        return Path(prebuilt).resolve()
-    sys.path.insert(0, str(ROOT))
-    import build
-
-    spec = next(s for s in build.FMU_SPECS if s.name == "RotorTouchdown")
-    return build.build_fmu(spec, tmp_path_factory.mktemp("fmu"))
-
-
 @pytest.fixture(scope="module")
 def report(fmu_path: Path) -> dict[str, Any]:
     cfg = fuzz_fmu.FuzzConfig(fmu=fmu_path, cases=CASES, seed=SEED, jobs=2)
