@@ -64,12 +64,6 @@ class DrivetrainAdapter(GuardedSlave):
         register(self, dv.TABLE, lambda _name: None, self._output_setter,
                  getters={"Omega": self._omega_getter})
 
-    def _output_setter(self, name: str) -> Any:
-        def refuse(value: Any) -> None:
-            self._fail(f"output '{name}' cannot be set by the host (the value {value!r} "
-                       f"was ignored)")
-        return refuse
-
     def _omega_getter(self) -> float:
         """Omega: the state once initialised, before that the start value (hosts that
         propagate outputs during initialisation then see the right speed)."""

@@ -61,6 +61,15 @@ class GuardedSlave(Fmi2Slave):
             self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
             return False
 
+    def _output_setter(self, name: str) -> Any:
+        """fmi2SetReal on an output: FMI's answer is fmi2Error, which PythonFMU cannot
+        return (only OK, or Fatal through its unsafe exception path); the value is ignored
+        and the instance fails as fmi2Error would make it: the next do_step is refused."""
+        def refuse(value: Any) -> None:
+            self._fail(f"output '{name}' cannot be set by the host (fmi2SetXXX on an "
+                       f"output is an error; the value {value!r} was ignored)")
+        return refuse
+
     def _fail(self, msg: str) -> None:
         first = not self._failure
         self._failure = msg

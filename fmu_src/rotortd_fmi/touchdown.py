@@ -104,15 +104,6 @@ class RotorTouchdownAdapter(GuardedSlave):
             self._changed = True
         return store
 
-    def _output_setter(self, name: str) -> Any:
-        """fmi2SetReal on an output: FMI's answer is fmi2Error, which PythonFMU cannot
-        return (only OK, or Fatal through its unsafe exception path); the value is ignored
-        and the instance fails as fmi2Error would make it: the next do_step is refused."""
-        def refuse(_value: Any) -> None:
-            self._fail(f"output '{name}' cannot be set by the host (fmi2SetXXX on an "
-                       f"output is an error; the value {_value!r} was ignored)")
-        return refuse
-
     # ------------------------------------------------------------------ FMI calls
     def setup_experiment(self, start_time: float = 0.0, stop_time: float | None = None,
                          tolerance: float | None = None) -> None:
