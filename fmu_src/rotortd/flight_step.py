@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Callable
 
 from .events import ContactLocator, flight_is_clear
 from .flight import FlightModel
@@ -75,7 +76,12 @@ class FlightSteps:
         return cmath.exp(1j * self._psi)
 
     def _advance_psi(self, ds: float) -> None:
-        x = self._psi + self._inputs[0] * ds
+        """Advance the spin angle over ds (s) at the held speed."""
+        self._add_psi(self._inputs[0] * ds)
+
+    def _add_psi(self, dpsi: float) -> None:
+        """Add dpsi (rad) to the spin angle, kept in [-pi, pi) with whole turns apart."""
+        x = self._psi + dpsi
         k = math.floor((x + math.pi) / TWO_PI_HI)
         if k:
             x = (x - k * TWO_PI_HI) - k * TWO_PI_LO
@@ -177,16 +183,25 @@ class FlightSteps:
     def _low_speed_contact(self, n: complex, v: float, v_plus: complex) -> bool:
         """The low-speed rule of the module docstring: does this impact start contact?"""
         p = self._p
+
+        def w_ref() -> float:
+            vt = (n.conjugate() * v_plus).imag
+            return max(self._wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
+
         A = self._outward_accel(n, v_plus)
-        if A <= 0.0:
-            return False
-        vb = p.d * v
-        if vb * vb <= 2.0 * A * ETA_HEIGHT * p.c_r:
-            return True
-        v1 = math.sqrt(2.0 * A * ETA_HEIGHT * p.c_r)
-        if p.d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(p.d):
-            return False
-        wf = self._wf
-        vt = (n.conjugate() * v_plus).imag
-        w_ref = max(wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
-        return 2.0 * vb / A <= ETA_TIME / w_ref
+        return starts_contact(A, p.d * v, p.d, p.c_r, w_ref)
+
+
+def starts_contact(A: float, vb: float, d: float, c_r: float,
+                   w_ref: Callable[[], float]) -> bool:
+    """The low-speed rule of the module docstring for an impact whose rebound speed is
+    vb (m/s) under the outward acceleration A (m/s^2) at the wall, restitution d, clearance
+    c_r (m); w_ref() (rad/s) is the reference rate of rule (2), asked only if needed."""
+    if A <= 0.0:
+        return False
+    if vb * vb <= 2.0 * A * ETA_HEIGHT * c_r:
+        return True
+    v1 = math.sqrt(2.0 * A * ETA_HEIGHT * c_r)
+    if d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(d):
+        return False
+    return 2.0 * vb / A <= ETA_TIME / w_ref()
