@@ -1,0 +1,473 @@
+"""Free flight of a rigid rotor whose spin speed is a state (MODEL.md 6, spin-SPEC "Free flight").
+
+Frame and units: inertial, SI. State: geometric centre ``z`` (m, complex), ``v = z'`` (m/s),
+spin angle ``psi`` (rad, unwrapped) and ``Omega = psi'`` (rad/s). With E = e^{i(psi + phi)},
+F = a (F_bias - c v - k z) + F_ext (N, at the geometric centre):
+
+    J Omega' = T_drive + e_c Im(conj(F) E)
+    m z''    = F - i m g + m e_c (Omega^2 - i Omega') E        (i.e. m z_G'' = F - i m g)
+
+``SpinFlight(...).run(rem, limit)`` advances at most ``rem`` seconds and stops at the first
+contact with the clearance circle |z| = c_r.
+
+Trajectory
+----------
+* Closed form (a == 0 and F_ext == 0, the drop scene): the mass centre z_G = z + e_c E moves on
+  a parabola and psi is quadratic, z(t) = z_G0 + z_G0' t - i g t^2/2 - e_c E0 e^{i(Omega0 t +
+  alpha t^2/2)}, alpha = T_drive/J; evaluated directly at every point (no drift).
+* Otherwise a Taylor method of order ORDER (24) with the coefficients from the recurrences of
+  the ODE written for z_G (``_taylor``: two convolutions per order, conj(F) * E and
+  Omega * E). Each step's length h makes the last two terms of the z and Omega series at most
+  TAYLOR_TOL (1e-16) times their scales (c_r; max(|Omega|, w)), the Jorba-Zou criterion;
+  with the series' geometric decay that bounds the truncation error of a step by about
+  2e-16 of the scale (an estimate from the tail, not an enclosure). The dense output is
+  the Taylor polynomial itself (no extra RHS evaluations). Stated error: per step at most
+  1e-15 of c_r in position and of the step's velocity scale |v| + w c_r in velocity
+  (truncation 2e-16 plus the rounding of the series sum, |terms| <= e^{w h} ~ 10 times the
+  sum); over a flight of n steps at most n times that plus the propagation through the
+  flow (tests: <= 1e-13 c_r over 0.1 s, against a 40-digit mpmath Taylor integration).
+
+Contact search (certificate)
+----------------------------
+The gap is G(t) = |z|^2/c_r^2 - 1 (dimensionless). At a point s, with z, v, a = z'',
+j = z''' from the ODE at the point's state,
+
+    G' = 2 Re(conj(z) v)/c_r^2,  G'' = 2(|v|^2 + Re(conj(z) a))/c_r^2,
+    G''' = 2(3 Re(conj(v) a) + Re(conj(z) j))/c_r^2,
+    |G''''| <= G4 = 2(6 A^2 + 8 V Jm + c_r L)/c_r^2 on [s, s + tau],
+
+where V, W, D, A, Jm, L bound |v|, |Omega|, |Omega'|, |z''|, |z'''|, |z''''| on [s, s + tau]
+while |z| <= c_r (``bounds``: an a-priori bootstrap V >= |v(s)| + tau A(V, W), W >=
+|Omega(s)| + tau D(V), checked after doubling the increments of two fixed-point sweeps,
+tau halved until it holds; then the derivative chain of the ODE: |F'|, |Omega''|, |F''|,
+|Omega'''|). As u^4/24 <= (tau/4) u^3/6, G(s + u) <= p(u) = G + G' u + G'' u^2/2 +
+(G''' + G4 tau/4 + band) u^3/6 for u in [0, tau]; band = 16 eps of the bound of |G'''|
+(rounding), and in the integrated case every coefficient gets, in addition, the method's
+point error RHO_INT (a relative error of the state, times the size of the coefficient's
+terms). The step to p's first root (events.safe_step, the left end of its bracket) is safe:
+a contact before it would be a first exit at which the bound, valid up to it, is negative.
+Far from the wall tau = min(remaining, HORIZON/w) and the trajectory advances by tau.
+
+Resolution: a point is at the wall when G >= -TOL_G (16 eps: |z| within ~8 eps of c_r, a few
+ulp). There: moving outward with a resolvable excursion (G' above its rounding band and
+G + G'^2/(2|G''|) > TOL_G) is an impact, polished by Newton on G to |G| <= 4 eps (the contact
+time is then within the conditioning limit eps c_r/rdot); G' zero to its band with the motion
+curving outward (G'' above its band, or zero to it with G''' > 0) is a touch, also a contact;
+moving inward continues with G clamped to 0; tangential with G'' <= 0 is a grazing pass that
+steps on by a grace step (``_grace``: the time within which no excursion beyond TOL_G can be
+resolved). So a crossing deeper than TOL_G (plus, integrated, the method's error) can never
+be missed, and a touch within a few ulp is either reported as contact or passed.
+
+Work: one unit per point evaluation (a state with its z'' and z'''), one per bound
+(``_bounds``), one per bracket iteration of the safe step (events.Work.iters) and ORDER per
+Taylor step (one per order of the recurrences). Bound: each advance costs >= 2 units and
+either moves by tau (at most rem w/HORIZON + 1 such), or approaches a transversal crossing
+with fourth-order convergence (3-6 advances), or passes a near-graze superlinearly (its
+distance to the tangency point squares, about log2 log(1/TOL_G) ~ 6 advances), or moves by a
+grace step (>= (6 TOL_G/G3max)^(1/3)); ``limit`` caps it all: ContactWorkExceeded beyond it.
+"""
+
+from __future__ import annotations
+
+import bisect
+import cmath
+import math
+from dataclasses import dataclass
+from operator import mul
+
+from .events import Work, safe_step
+from .params import RotorParams
+from .wall import ContactWorkExceeded
+
+EPS = 2.220446049250313e-16
+TINY = 5e-324
+TOL_G = 16.0 * EPS
+"""Contact resolution of G = |z|^2/c_r^2 - 1: G >= -TOL_G is at the wall (|z| within ~8 eps)."""
+POLISH_G = 4.0 * EPS
+"""Newton on G stops once |G| <= POLISH_G."""
+HORIZON = 0.5
+"""Longest interval one bound covers, in units of 1/w (w the flight's fastest rate)."""
+ORDER = 24
+"""Order of the Taylor method (integrated case)."""
+TAYLOR_TOL = 1e-16
+"""Tail tolerance of a Taylor step, relative to the scales c_r (z) and max(|Omega|, w) (Omega)."""
+STEP_MAX = 256.0
+"""Longest Taylor step, in units of 1/w (reached only by series that end early)."""
+RHO_INT = 8.0 * EPS
+"""Relative point error of the integrated state (truncation of the current step plus the
+rounding of its series) that the search adds to the coefficients of its bound."""
+
+
+@dataclass(frozen=True)
+class FlightEnd:
+    """Where a free flight stopped (inertial frame, SI)."""
+
+    duration: float
+    """s, from the segment start to its end or to the contact."""
+    z: complex
+    """m, geometric centre at the end (on |z| = c_r, projected onto it, for a contact)."""
+    v: complex
+    """m/s, z' at the end."""
+    psi: float
+    """rad, spin angle at the end (unwrapped: psi0 + increment)."""
+    Omega: float
+    """rad/s, spin speed at the end."""
+    event: str | None
+    """"contact" (|z| reaches c_r from inside, or a touch) or None (rem reached)."""
+    work: int
+    """Deterministic work units used (module docstring)."""
+
+
+class SpinFlight:
+    """One free flight from (z, v, psi, Omega) under inputs held constant (module docstring).
+
+    p: rotor parameters; J: polar inertia about the mass centre (kg m^2, > 0); a: AMB on in
+    [0, 1]; F_ext: external force at the geometric centre (N, complex, without gravity);
+    T_drive: drive torque (N m). ``force_integration`` uses the Taylor method even when the
+    closed form applies (for tests).
+    """
+
+    def __init__(
+        self,
+        p: RotorParams,
+        J: float,
+        a: float,
+        F_ext: complex,
+        T_drive: float,
+        z: complex,
+        v: complex,
+        psi: float,
+        Omega: float,
+        *,
+        force_integration: bool = False,
+    ) -> None:
+        if not (J > 0.0 and math.isfinite(J)):
+            raise ValueError(f"J = {J!r} kg m^2: it must be finite and > 0")
+        self.p = p
+        self.J = float(J)
+        self.a = float(a)
+        self.F_ext = complex(F_ext)
+        self.T = float(T_drive)
+        self.z0, self.v0 = complex(z), complex(v)
+        self.psi0, self.Om0 = float(psi), float(Omega)
+        self.cr = p.c_r
+        self.ec = p.e_c
+        self.m = p.m
+        self.g = p.g
+        self.E0 = cmath.exp(1j * (self.psi0 + p.phi))
+        self.alpha = self.T / self.J
+        self.closed = self.a == 0.0 and self.F_ext == 0j and not force_integration
+        # F = F0 - ac v - ak z (N); z_G'' = F/m - i g
+        self.F0 = self.a * p.bias_force + self.F_ext
+        self.cA = self.a * p.c
+        self.kA = self.a * p.k
+        self.f0m = self.F0 / self.m - 1j * self.g  # constant part of z_G'' (m/s^2)
+        self.f0m_abs = abs(self.f0m)
+        self.F0_abs = abs(self.F0)
+        cr = self.cr
+        w = max(
+            abs(self.Om0),
+            abs(self.v0) / cr,
+            math.sqrt(self.kA / self.m),
+            self.cA / self.m,
+            math.sqrt((self.f0m_abs + self.ec * abs(self.Om0) ** 2) / cr),
+            abs(self.alpha) ** 0.5,
+            math.sqrt(self.ec * (self.F0_abs + self.kA * cr) / self.J),
+            1e-9,
+        )
+        self.w = w
+        self.horizon = HORIZON / w
+        self.Om_scale = max(abs(self.Om0), w)
+        self.rho = 0.0 if self.closed else RHO_INT
+        if self.closed:
+            self.zG0 = self.z0 + self.ec * self.E0
+            self.wG0 = self.v0 + 1j * self.ec * self.Om0 * self.E0
+        else:
+            self._steps: list[tuple[float, float, list[complex], list[complex], list[float],
+                                    float]] = []
+            self._starts: list[float] = []
+
+    # ---------------------------------------------------------------- trajectory
+    def state(self, s: float, work: Work) -> tuple[complex, complex, float, float, complex]:
+        """(z, v, psi - psi0, Omega, E) at local time s (s >= 0), m, m/s, rad, rad/s."""
+        work.evals += 1
+        if self.closed:
+            Om0, al = self.Om0, self.alpha
+            dpsi = s * (Om0 + 0.5 * al * s)
+            E = self.E0 * cmath.exp(1j * dpsi)
+            Om = Om0 + al * s
+            ec = self.ec
+            z = self.zG0 + s * (self.wG0 - 0.5j * self.g * s) - ec * E
+            v = self.wG0 - 1j * self.g * s - 1j * ec * Om * E
+            return z, v, dpsi, Om, E
+        return self._dense(s, work)
+
+    def derivs(self, z: complex, v: complex, Om: float, E: complex) -> tuple[complex, complex]:
+        """(z'', z''') in m/s^2, m/s^3 from the ODE at the state (z, v, Omega, E)."""
+        ec, J = self.ec, self.J
+        F = self.F0 - self.cA * v - self.kA * z
+        Omd = (self.T + ec * (F.conjugate() * E).imag) / J
+        acc = F / self.m - 1j * self.g + ec * complex(Om * Om, -Omd) * E
+        F1 = -self.cA * acc - self.kA * v
+        Omdd = ec * (F1.conjugate() * E + F.conjugate() * (1j * Om) * E).imag / J
+        jerk = F1 / self.m + ec * complex(3.0 * Om * Omd, Om * Om * Om - Omdd) * E
+        return acc, jerk
+
+    def _taylor(self, z0: complex, v0: complex, Om0: float, E0: complex
+                ) -> tuple[list[complex], list[complex], list[float]]:
+        """Taylor coefficients (z_k, E_k, Omega_k) of the flight from (z0, v0, Omega0, E0).
+
+        With z_G = z + e_c E: (k+1)(k+2) zG_{k+2} = F_k/m - i g [k=0], F_k = F0 [k=0] -
+        a c (k+1) z_{k+1} - a k z_k; (k+1) J Omega_{k+1} = T [k=0] + e_c Im(sum conj(F_j)
+        E_{k-j}); (k+2) E_{k+2} = i sum Omega_j E_{k+1-j}."""
+        N = ORDER
+        ec, m, cA, kA, J = self.ec, self.m, self.cA, self.kA, self.J
+        zc = [z0, v0]
+        Ec = [E0, 1j * Om0 * E0]
+        Oc = [Om0]
+        Fc: list[complex] = []  # conj(F_k)
+        for k in range(N - 1):
+            Fk = -cA * (k + 1) * zc[k + 1] - kA * zc[k]
+            if k == 0:
+                Fk += self.F0
+            Fc.append(Fk.conjugate())
+            tq = ec * sum(map(mul, Fc, Ec[k::-1])).imag
+            if k == 0:
+                tq += self.T
+            Oc.append(tq / (J * (k + 1)))
+            Ek2 = (1j / (k + 2)) * sum(map(mul, Oc, Ec[k + 1::-1]))
+            Ec.append(Ek2)
+            zG = Fk / m
+            if k == 0:
+                zG -= 1j * self.g
+            zc.append(zG / ((k + 1) * (k + 2)) - ec * Ek2)
+        return zc, Ec, Oc
+
+    def _new_step(self, work: Work) -> None:
+        """Append the next Taylor step (from the end of the last one, or the start)."""
+        if work.total > self._limit:
+            raise ContactWorkExceeded(
+                f"free flight: work bound {self._limit} reached in the Taylor integration",
+                work=work.total)
+        if self._steps:
+            t0, h = self._steps[-1][0], self._steps[-1][1]
+            z, v, dpsi, Om, _ = self._poly(self._steps[-1], h)
+        else:
+            t0, h, z, v, dpsi, Om = 0.0, 0.0, self.z0, self.v0, 0.0, self.Om0
+        E = self.E0 * cmath.exp(1j * dpsi)
+        zc, Ec, Oc = self._taylor(z, v, Om, E)
+        work.evals += ORDER
+        N = ORDER
+        hz = _tail_step(abs(zc[N - 1]), abs(zc[N]), TAYLOR_TOL * self.cr, N)
+        ho = _tail_step(abs(Oc[N - 2]), abs(Oc[N - 1]), TAYLOR_TOL * self.Om_scale, N - 1)
+        hstep = min(hz, ho, STEP_MAX / self.w)
+        t1 = t0 + h
+        self._steps.append((t1, hstep, zc, Ec, Oc, dpsi))
+        self._starts.append(t1)
+
+    @staticmethod
+    def _poly(step: tuple[float, float, list[complex], list[complex], list[float], float],
+              u: float) -> tuple[complex, complex, float, float, complex]:
+        """Evaluate a Taylor step at local offset u: (z, v, dpsi, Omega, E)."""
+        _, _, zc, Ec, Oc, dpsi0 = step
+        N = len(zc) - 1
+        z = zc[N]
+        v = N * zc[N]
+        for k in range(N - 1, 0, -1):
+            z = z * u + zc[k]
+            v = v * u + k * zc[k]
+        z = z * u + zc[0]
+        E = Ec[N]
+        for k in range(N - 1, -1, -1):
+            E = E * u + Ec[k]
+        n = len(Oc) - 1
+        Om = Oc[n]
+        ps = Oc[n] / (n + 1)
+        for k in range(n - 1, -1, -1):
+            Om = Om * u + Oc[k]
+            ps = ps * u + Oc[k] / (k + 1)
+        return z, v, dpsi0 + ps * u, Om, E
+
+    def _dense(self, s: float, work: Work) -> tuple[complex, complex, float, float, complex]:
+        """The integrated state at s from the Taylor step that covers it."""
+        while not self._steps or s > self._steps[-1][0] + self._steps[-1][1]:
+            self._new_step(work)
+        i = bisect.bisect_right(self._starts, s) - 1
+        step = self._steps[max(i, 0)]
+        return self._poly(step, s - step[0])
+
+    # ---------------------------------------------------------------- bounds
+    def bounds(self, V0: float, W0: float, tau: float) -> tuple[float, float, float]:
+        """(tau', G3max, G4max): on [s, s + tau'] (tau' <= tau, s, while |z| <= c_r), with
+        |v(s)| = V0 and |Omega(s)| = W0, |G'''| <= G3max and |G''''| <= G4max (1/s^3, 1/s^4)."""
+        ec, J, cr, m = self.ec, self.J, self.cr, self.m
+        cA, kA = self.cA, self.kA
+        T = abs(self.T)
+        if self.closed:
+            W = W0 + tau * abs(self.alpha)
+            D = abs(self.alpha)
+            A = self.g + ec * (W * W + D)
+            V = V0 + tau * A
+            Fm = F1 = F2 = B2 = B3 = 0.0
+        else:
+            for _ in range(200):
+                V, W = V0, W0
+                for _ in range(2):
+                    Fm = self.F0_abs + cA * V + kA * cr
+                    D = (T + ec * Fm) / J
+                    A = self.f0m_abs + (cA * V + kA * cr) / m + ec * (W * W + D)
+                    V, W = V0 + tau * A, W0 + tau * D
+                V, W = 2.0 * V - V0 + TINY, 2.0 * W - W0 + TINY  # twice the increments
+                Fm = self.F0_abs + cA * V + kA * cr
+                D = (T + ec * Fm) / J
+                A = self.f0m_abs + (cA * V + kA * cr) / m + ec * (W * W + D)
+                if V0 + tau * A <= V and W0 + tau * D <= W:
+                    break
+                tau *= 0.5
+            else:
+                raise ContactWorkExceeded(f"free flight: no a-priori bound at |v| = {V0!r}",
+                                          work=0)
+            F1 = cA * A + kA * V
+            B2 = ec * (F1 + Fm * W) / J
+        Jm = F1 / m + ec * (3.0 * W * D + B2 + W * W * W)
+        if not self.closed:
+            F2 = cA * Jm + kA * A
+            B3 = ec * (F2 + 2.0 * F1 * W + Fm * (D + W * W)) / J
+        WD = W * W + D
+        L = F2 / m + ec * (2.0 * D * D + 2.0 * W * B2 + B3 + 2.0 * W * (2.0 * W * D + B2)
+                           + WD * WD)
+        c2 = cr * cr
+        G3 = 2.0 * (6.0 * V * A + cr * Jm) / c2
+        G4 = 2.0 * (6.0 * A * A + 8.0 * V * Jm + cr * L) / c2
+        return tau, G3, G4
+
+    # ---------------------------------------------------------------- search
+    def run(self, rem: float, limit: int) -> FlightEnd:
+        """Advance at most ``rem`` s; stop at the first contact; raise ContactWorkExceeded
+        (with ``work``) if more than ``limit`` work units would be needed."""
+        work = Work()
+        self._limit = limit
+        cr = self.cr
+        ic2 = 1.0 / (cr * cr)
+        rho = self.rho
+        s = 0.0
+        z, v, dpsi, Om, E = self.state(0.0, work)
+        while True:
+            if work.total > limit:
+                raise ContactWorkExceeded(
+                    f"free flight: work bound {limit} reached at t = {s!r} s of {rem!r} s",
+                    work=work.total)
+            acc, jerk = self.derivs(z, v, Om, E)
+            zc = z.conjugate()
+            g0 = (z * zc).real * ic2 - 1.0
+            g1 = 2.0 * (zc * v).real * ic2
+            g2 = 2.0 * ((v * v.conjugate()).real + (zc * acc).real) * ic2
+            g3 = 2.0 * (3.0 * (v.conjugate() * acc).real + (zc * jerk).real) * ic2
+            az, av = abs(z), abs(v)
+            M1 = 2.0 * az * av * ic2
+            M2 = 2.0 * (av * av + az * abs(acc)) * ic2
+            if rho:  # the integrated state's point error, in every coefficient
+                g0 += 3.0 * rho
+                g1 += 3.0 * rho * M1
+                g2 += 3.0 * rho * M2
+            if g0 >= -TOL_G:
+                kind = self._at_wall(g0, g1, g2, g3, M1, M2)
+                if kind == "impact":
+                    if s == 0.0:
+                        return self._end(0.0, z, v, dpsi, Om, "contact", work)
+                    return self._polish(s, z, v, dpsi, Om, rem, work)
+                if kind == "touch":
+                    return self._end(s, z, v, dpsi, Om, "contact", work)
+                if kind == "graze":
+                    if s >= rem:
+                        return self._end(rem, z, v, dpsi, Om, None, work)
+                    s = min(rem, s + self._grace(v, Om, g3, work))
+                    z, v, dpsi, Om, E = self.state(s, work)
+                    continue
+                g0, g1 = 0.0, min(g1, 0.0)  # leaving the wall
+            remaining = rem - s
+            if remaining <= 0.0:
+                return self._end(rem, z, v, dpsi, Om, None, work)
+            work.evals += 1
+            tau, G3m, G4m = self.bounds(av, abs(Om), min(remaining, self.horizon))
+            c3 = g3 + 0.25 * tau * G4m + (16.0 * EPS + 3.0 * rho) * G3m + TINY
+            u = safe_step(g0, g1, g2, c3, tau, work)
+            if u is None:
+                u = tau
+            elif u <= 0.0:  # on the wall, nothing moving it: a touch
+                return self._end(s, z, v, dpsi, Om, "contact", work)
+            s = s + u if u < remaining else rem
+            z, v, dpsi, Om, E = self.state(s, work)
+
+    @staticmethod
+    def _at_wall(g0: float, g1: float, g2: float, g3: float, M1: float, M2: float) -> str:
+        """Classify a point with G >= -TOL_G: "impact", "touch", "leave" or "graze"."""
+        tol1 = 16.0 * EPS * M1 + 1e-300
+        tol2 = 64.0 * EPS * M2 + 1e-300
+        if g1 > tol1 and (g2 >= 0.0 or g0 + g1 * g1 / (-2.0 * g2) > TOL_G):
+            return "impact"  # outward, with an excursion beyond the wall above resolution
+        if g1 < -tol1:
+            return "leave"
+        if g2 > tol2 or (g2 >= -tol2 and g3 > 0.0):
+            return "touch"
+        return "graze"
+
+    def _grace(self, v: complex, Om: float, g3: float, work: Work) -> float:
+        """Step (s) past a tangential point (G within TOL_G of 0, G' within its band, G'' <= 0
+        to its band): the larger of (a) the time within which the bound of |G'''| cannot move
+        G by TOL_G, and (b) when G''' < 0, the time the cubic term needs to bring G 8 TOL_G
+        inside, capped at 2|G'''|/G4max so that the quartic term stays below half of it.
+        Within it no excursion beyond the resolution can form."""
+        work.evals += 1
+        tau, G3m, G4m = self.bounds(abs(v), abs(Om), self.horizon)
+        t_bound = (6.0 * TOL_G / max(G3m, 1e-300)) ** (1.0 / 3.0)
+        t_cubic = 0.0
+        if g3 < 0.0:
+            t_cubic = min((48.0 * TOL_G / -g3) ** (1.0 / 3.0), 2.0 * -g3 / max(G4m, 1e-300))
+        return min(max(t_bound, t_cubic), tau)
+
+    def _polish(self, s: float, z: complex, v: complex, dpsi: float, Om: float, rem: float,
+                work: Work) -> FlightEnd:
+        """Newton on G from a point within TOL_G of the wall moving outward; best point."""
+        ic2 = 1.0 / (self.cr * self.cr)
+        zc = z.conjugate()
+        g0 = (z * zc).real * ic2 - 1.0
+        g1 = 2.0 * (zc * v).real * ic2
+        best = (abs(g0), s, z, v, dpsi, Om)
+        for _ in range(6):
+            if g1 <= 0.0 or abs(g0) <= POLISH_G:
+                break
+            s_new = s - g0 / g1
+            if s_new == s:
+                break
+            s = s_new
+            z, v, dpsi, Om, _ = self.state(s, work)
+            zc = z.conjugate()
+            g0 = (z * zc).real * ic2 - 1.0
+            g1 = 2.0 * (zc * v).real * ic2
+            if abs(g0) < best[0]:
+                best = (abs(g0), s, z, v, dpsi, Om)
+        _, s, z, v, dpsi, Om = best
+        if s > rem:  # the root lies beyond the segment: end there, just inside the wall
+            z, v, dpsi, Om, _ = self.state(rem, work)
+            return self._end(rem, z, v, dpsi, Om, None, work)
+        return self._end(s, z, v, dpsi, Om, "contact", work)
+
+    def _end(self, s: float, z: complex, v: complex, dpsi: float, Om: float,
+             event: str | None, work: Work) -> FlightEnd:
+        """The FlightEnd at s; a contact's z is projected onto the circle."""
+        if event == "contact":
+            r = abs(z)
+            if r > 0.0:
+                z = z * (self.cr / r)
+        return FlightEnd(s, z, v, self.psi0 + dpsi, Om, event, work.total)
+
+
+def _tail_step(a: float, b: float, tol: float, N: int) -> float:
+    """Step h with a h^(N-1) <= tol and b h^N <= tol (inf when both coefficients are 0)."""
+    h = math.inf
+    if a > 0.0:
+        h = (tol / a) ** (1.0 / (N - 1))
+    if b > 0.0:
+        h = min(h, (tol / b) ** (1.0 / N))
+    return h
