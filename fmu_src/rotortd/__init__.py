@@ -2,7 +2,8 @@
 
 Pure Python on ``math``/``cmath`` (no numpy, no pythonfmu), so it is fast for scalar
 work and safe inside any FMI host. SI units and the inertial frame unless stated.
-The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``TouchdownCore``.
+The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``TouchdownCore``
+(the spin held over each step) and ``SpinCore`` (the spin as a state, MODEL.md §6).
 """
 
 from .contact import RubEquilibrium, WallForces, forward_rub_equilibria
@@ -21,6 +22,7 @@ from .simulator import (
     TouchdownCore,
     work_cap,
 )
+from .spin_core import SpinCore, restore_core
 
 __all__ = [
     "LIMITS",
@@ -40,9 +42,11 @@ __all__ = [
     "RotorParams",
     "RubEquilibrium",
     "ScaledParams",
+    "SpinCore",
     "StepReport",
     "TouchdownCore",
     "WallForces",
     "forward_rub_equilibria",
+    "restore_core",
     "work_cap",
 ]

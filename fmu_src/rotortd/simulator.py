@@ -55,6 +55,9 @@ __all__ = [
 class TouchdownCore(FlightSteps, ContactSteps):
     """Rotor in a touchdown bearing, advanced step by step (see the module docstring)."""
 
+    SPIN_STATE = False
+    """The spin speed is a held input (False) or a state (SpinCore: True)."""
+
     def __init__(
         self,
         params: RotorParams,
@@ -391,6 +394,12 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """Restore a state produced by get_state (same or compatible version), or a
         CoreState; ParameterError for another schema or version (nothing changes)."""
         cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
+        if (cs.J is not None) != self.SPIN_STATE:
+            raise ParameterError(
+                "the state is of a core whose spin is "
+                f"{'a state (J set)' if cs.J is not None else 'held (no J)'}; this core's "
+                f"spin is {'a state' if self.SPIN_STATE else 'held'}: restore it into a "
+                f"{'SpinCore' if cs.J is not None else 'TouchdownCore'} (rotortd.restore_core)")
         self._p = cs.params
         self._t, self._t_lo = cs.t, cs.t_lo
         self._z, self._v = cs.z, cs.v

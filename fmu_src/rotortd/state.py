@@ -3,11 +3,12 @@
 Frame and units: inertial, SI. ``CoreState`` holds everything the core needs to continue
 bit for bit; ``TouchdownCore.get_state``/``set_state`` are ``CoreState.to_json``/``from_json``
 and the core's ``state`` property is the same record, read-only. The JSON schema is
-``rotortd-state`` version 1 (floats round-trip exactly through JSON's repr).
+``rotortd-state`` version 2 (floats round-trip exactly through JSON's repr).
 
-Versions: a state of another schema or version is refused with a message naming both.
-A future version (issue 17: the spin Omega and its angle psi become states) adds its fields
-here, raises STATE_VERSION once, and reads version 1 states by ``from_json``'s defaults.
+Versions: version 2 adds ``J``, the polar inertia (kg m^2) of a core whose spin is a state
+(``SpinCore``; then ``inputs[0]`` is the spin speed, a state), null for the held-speed
+``TouchdownCore``. A version 1 state reads as a held-speed state. A state of another schema
+or version is refused with a message naming both.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from dataclasses import dataclass
 
 from .params import ParameterError, RotorParams
 
-STATE_SCHEMA, STATE_VERSION = "rotortd-state", 1
+STATE_SCHEMA, STATE_VERSION = "rotortd-state", 2
+READABLE_VERSIONS = (1, 2)
 
 
 @dataclass(frozen=True)
@@ -56,10 +58,13 @@ class CoreState:
     slide_step: float
     """The sliding integrator's next step size (s); inf before any sliding."""
     inputs: tuple[float, complex, float]
-    """The held inputs of the last step: Omega (rad/s), F_ext (N), amb_on."""
+    """The held inputs of the last step: Omega (rad/s), F_ext (N), amb_on. With the spin as
+    a state (J set), Omega is the spin speed at t."""
+    J: float | None = None
+    """Polar inertia about the mass centre (kg m^2) when the spin is a state, else None."""
 
     def to_json(self) -> dict:
-        """The JSON-serialisable dict of schema ``rotortd-state`` version 1."""
+        """The JSON-serialisable dict of schema ``rotortd-state``, version STATE_VERSION."""
         p, z, v, (W, F, a) = self.params, self.z, self.v, self.inputs
         return {
             "schema": STATE_SCHEMA,
@@ -84,17 +89,20 @@ class CoreState:
             "t_contact": None if math.isnan(self.t_contact) else self.t_contact,
             "H": None if math.isinf(self.slide_step) else self.slide_step,
             "inputs": [W, F.real, F.imag, a],
+            "J": self.J,
         }
 
     @classmethod
     def from_json(cls, st: dict) -> CoreState:
         """The state of a dict made by ``to_json``; ParameterError for another schema or
         version."""
-        if st.get("schema") != STATE_SCHEMA or st.get("version") != STATE_VERSION:
+        if st.get("schema") != STATE_SCHEMA or st.get("version") not in READABLE_VERSIONS:
             raise ParameterError(
                 f"state schema {st.get('schema')!r} version {st.get('version')!r} is not "
-                f"supported: expected {STATE_SCHEMA!r} version {STATE_VERSION}"
+                f"supported: expected {STATE_SCHEMA!r} version "
+                f"{' or '.join(map(str, READABLE_VERSIONS))}"
             )
+        J = st.get("J") if st["version"] >= 2 else None
         W, fx, fy, a = st["inputs"]
         return cls(
             params=RotorParams(**st["params"]),
@@ -117,4 +125,5 @@ class CoreState:
             t_contact=math.nan if st["t_contact"] is None else float(st["t_contact"]),
             slide_step=math.inf if st["H"] is None else float(st["H"]),
             inputs=(float(W), complex(fx, fy), float(a)),
+            J=None if J is None else float(J),
         )

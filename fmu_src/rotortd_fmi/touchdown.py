@@ -36,7 +36,9 @@ from .guard import GuardedSlave
 from .variables import meta, range_violations, register
 
 STATE_SCHEMA = "rotortd-fmu-state"
-STATE_VERSION = 1
+STATE_VERSION = 2
+"""Version 2: the spin state (integrate_spin) is in the core's state; version 1 states of
+a held-speed instance still load, those of the former sub-stepped spin coupler do not."""
 
 VARIABLE_META = meta(tv.TABLE)  # read by build.py
 TUNABLE, FIXED, INPUTS = tv.TUNABLE, tv.FIXED, tv.INPUTS
@@ -93,7 +95,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._seen_fixed: tuple | None = None
         self._seen_tunables: tuple | None = None
         self._seen_inputs: tuple | None = None
-        self._spin: Any = None      # rotortd_drive.SpinCoupler if integrate_spin
+        self._h_spin_warned = False  # h_spin is deprecated: warned once if set
         self._kinematics: tuple[float, ...] = ()  # the last published kinematics
 
     def _watched_setter(self, name: str) -> Any:
@@ -102,6 +104,11 @@ class RotorTouchdownAdapter(GuardedSlave):
         def store(value: Any) -> None:
             setattr(self, name, value)
             self._changed = True
+            if name == "h_spin" and not self._h_spin_warned:
+                self._h_spin_warned = True
+                self.log("h_spin is deprecated and has no effect: with integrate_spin the "
+                         "spin is an exact state of the core (docs/model.md 8)",
+                         Fmi2Status.warning)
         return store
 
     # ------------------------------------------------------------------ FMI calls
@@ -122,7 +129,6 @@ class RotorTouchdownAdapter(GuardedSlave):
         except rotortd.CrossParameterError as exc:
             raise ModelError(f"cross-parameter constraint: {exc}") from exc
         omega = self._input_values()[0]
-        self._spin = self._make_spin(omega)
         self.Omega_out = omega
         self._fixed_snapshot = self._fixed_values()
         self._publish_kinematics(omega, float(self.amb_on))
@@ -134,6 +140,16 @@ class RotorTouchdownAdapter(GuardedSlave):
         outside the clearance is projected onto it (rotortd.limits.start_position)."""
         params = self._make_params(rotortd)
         omega, f_ext, amb, _t_drive = self._input_values()
+        if self.integrate_spin:  # the spin is a state; Omega is its initial value
+            J = float(self.J)
+            if self.start_steady:
+                return rotortd.SpinCore.on_steady_whirl(
+                    params, omega, F_ext=f_ext, amb_on=amb, psi0=float(self.psi0),
+                    t0=self._t0, J=J)
+            return rotortd.SpinCore(
+                params, J, z0=complex(float(self.x0), float(self.y0)),
+                v0=complex(float(self.vx0), float(self.vy0)), psi0=float(self.psi0),
+                Omega0=omega, t0=self._t0)
         if self.start_steady:
             return rotortd.TouchdownCore.on_steady_whirl(
                 params, omega, F_ext=f_ext, amb_on=amb, psi0=float(self.psi0), t0=self._t0)
@@ -164,14 +180,6 @@ class RotorTouchdownAdapter(GuardedSlave):
         if fh.tell() == 0:
             fh.write(IMPACT_LOG_HEADER)
         return fh
-
-    def _make_spin(self, omega: float) -> Any:
-        """The spin integrator (integrate_spin) or None."""
-        if not self.integrate_spin:
-            return None
-        from rotortd_drive import SpinCoupler  # resources/rotortd_drive inside the FMU
-
-        return SpinCoupler(float(self.J), float(self.h_spin), omega)
 
     def _make_params(self, rotortd: Any) -> Any:
         kwargs = {f.name: float(getattr(self, f.name)) for f in fields(rotortd.RotorParams)
@@ -240,9 +248,9 @@ class RotorTouchdownAdapter(GuardedSlave):
                              f"model time {core.t!r}")
         omega, f_ext, amb, t_drive = self._step_inputs  # validated by _check_changes
         t_target = core.t + step_size
-        if self._spin is not None:
-            rep = self._spin.step(core, step_size, t_drive, F_ext=f_ext, amb_on=amb)
-            omega = self._spin.Omega
+        if core.SPIN_STATE:
+            rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
+            omega = core.Omega
         else:
             rep = core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
         self.Omega_out = omega
@@ -325,8 +333,7 @@ class RotorTouchdownAdapter(GuardedSlave):
                 "variables": values,
                 "core": None if self._core is None else self._core.get_state(),
                 "adapter": {"t0": self._t0, "failure": self._failure,
-                            "fixed_snapshot": self._fixed_snapshot,
-                            "spin": None if self._spin is None else self._spin.Omega},
+                            "fixed_snapshot": self._fixed_snapshot},
             }
             # JSON round trip: an independent deep copy, and proof that it serialises.
             return json.loads(json.dumps(state))
@@ -349,8 +356,12 @@ class RotorTouchdownAdapter(GuardedSlave):
     def _restore(self, state: dict[str, Any]) -> None:
         if not isinstance(state, dict) or state.get("schema") != STATE_SCHEMA:
             raise ModelError("not a rotortd FMU state (schema mismatch)")
-        if state.get("version") != STATE_VERSION:
+        if state.get("version") not in (1, STATE_VERSION):
             raise ModelError(f"unsupported FMU state version {state.get('version')!r}")
+        if state["version"] == 1 and state.get("adapter", {}).get("spin") is not None:
+            raise ModelError("the state was saved by the former sub-stepped spin coupler "
+                             "(FMU state version 1 with integrate_spin); it cannot be "
+                             "restored into the exact spin state of version 2")
         if "invalid" in state:
             raise ModelError(f"the saved state is invalid: {state['invalid']}")
         known = {v.name for v in self.vars.values()}
@@ -360,22 +371,18 @@ class RotorTouchdownAdapter(GuardedSlave):
         core_state, adapter = state["core"], state["adapter"]
         core = None
         if core_state is not None:  # built aside: a bad core state changes nothing
-            core = self._new_core_for_restore()
-            core.set_state(copy.deepcopy(core_state))
+            import rotortd
+
+            core = rotortd.restore_core(copy.deepcopy(core_state))
+            if bool(values["integrate_spin"]) != core.SPIN_STATE:
+                raise ModelError("the core state does not match integrate_spin")
         t0, failure = float(adapter["t0"]), str(adapter["failure"])
-        fixed_snapshot, spin = dict(adapter["fixed_snapshot"]), adapter.get("spin")
-        spin = None if spin is None else float(spin)
+        fixed_snapshot = dict(adapter["fixed_snapshot"])
         self._core = core
         for name, value in values.items():
             setattr(self, name, value)
         self._t0, self._failure, self._fixed_snapshot = t0, failure, fixed_snapshot
         self._forget_checks()
-        self._spin = None if spin is None else self._make_spin(spin)
-
-    def _new_core_for_restore(self) -> Any:
-        import rotortd
-
-        return rotortd.TouchdownCore(rotortd.RotorParams(), z0=0j, v0=0j, psi0=0.0, t0=0.0)
 
     @staticmethod
     def _fmu_state_to_bytes(state: dict[str, Any]) -> bytes:

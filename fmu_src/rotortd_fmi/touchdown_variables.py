@@ -30,27 +30,29 @@ TABLE: tuple[Var, ...] = (
     limited("vy0", PARAMETER, 0.0, "Initial velocity y; ignored if start_steady"),
     limited("psi0", PARAMETER, 0.0, "Initial spin angle"),
     # spin
-    limited("J", PARAMETER, 0.04, "Polar inertia of the spin, used if integrate_spin"),
-    limited("h_spin", PARAMETER, 1e-6, "Largest internal sub-step of the spin integration, "
-                                       "used if integrate_spin"),
+    limited("J", PARAMETER, 0.04, "Polar inertia of the rotor about its mass centre, used if "
+                                  "integrate_spin (must exceed m mu e_c (R + e_c))"),
+    limited("h_spin", PARAMETER, 1e-6, "Deprecated, no effect (the spin state is exact); "
+                                       "kept so that existing system files load"),
     fixed("levitate", "Boolean", True,
           "AMB bias force +i m g holds the rotor centred against gravity"),
     fixed("start_steady", "Boolean", False,
           "Start on the steady free whirl (error if not admissible); overrides x0, y0, vx0, "
           "vy0"),
     fixed("integrate_spin", "Boolean", False,
-          "Integrate the spin inside the FMU: J Omega' = T_drive + T_f, sub-stepped at "
-          "h_spin; the input Omega is then only the initial speed and Omega_out the spin"),
+          "The spin is a state of the rotor (one rigid body with inertia J, driven by "
+          "T_drive); the input Omega is then only the initial speed, Omega_out the spin"),
     fixed("impact_log", "String", "",
           "If not empty: CSV path; every impact is appended (time, x, y, vx-, vy-, vx+, vy+, "
           "rdot, P_n, P_t, stick)"),
     # inputs, held over a step
-    limited("Omega", INPUT, 184.2, "Spin speed, held over the step"),
+    limited("Omega", INPUT, 184.2, "Spin speed, held over the step; with integrate_spin "
+                                   "only the initial speed, ignored afterwards"),
     limited("F_x", INPUT, 0.0, "External force on the rotor, x"),
     limited("F_y", INPUT, 0.0, "External force on the rotor, y"),
     limited("amb_on", INPUT, 1.0, "Magnetic bearing state: 1 on, 0 failed"),
-    limited("T_drive", INPUT, 0.0, "Drive torque on the spin (motor minus drag), used if "
-                                   "integrate_spin"),
+    limited("T_drive", INPUT, 0.0, "Drive torque on the rotor (motor minus drag), held "
+                                   "over the step, used if integrate_spin"),
     # outputs
     output("x", "m", "Rotor centre position x, inertial, |(x, y)| <= c_r"),
     output("y", "m", "Rotor centre position y, inertial, |(x, y)| <= c_r"),
@@ -80,7 +82,7 @@ TABLE: tuple[Var, ...] = (
     output("t_last_impact", "s", "Time of the last impact; 0 before any impact"),
     output("v_last_impact", "m/s", "Normal speed rdot- of the last impact; 0 before any", 0.0),
     output("E_diss", "J", "Energy dissipated by contact, cumulative", 0.0),
-    output("Omega_out", "rad/s", "Spin speed at the end of the step: the integrated spin if "
+    output("Omega_out", "rad/s", "Spin speed at the end of the step: the spin state if "
                                  "integrate_spin, else the input Omega"),
     output("mode", "", "Contact mode at the end of the step: 0 free, 1 sliding, 2 rolling",
            0, 2, "Integer"),

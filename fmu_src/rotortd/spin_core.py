@@ -1,0 +1,337 @@
+"""The rotor with its spin as a state (MODEL.md §6): ``SpinCore``.
+
+Frame and units: inertial, SI. A ``SpinCore`` is a ``TouchdownCore`` whose spin speed Omega
+is a state instead of a held input: translation and spin are solved together as one rigid
+body (J the polar inertia about the mass centre), with the drive torque T_drive, the
+external force F_ext and amb_on held over a step. It shares the core's state layout, its
+views (kinematics, counters) and its serialisation (``CoreState`` with ``J`` set, the held
+Omega in ``inputs`` being the spin state), and replaces the step:
+
+    free flight (spin_flight.SpinFlight: closed form with the bearing off and no external
+    force, else integrated; rigorous contact search)
+    -> impacts (rigid.spin_impact: Newton + Coulomb through the Delassus matrix, capped so
+       that no impact creates energy)
+    -> sustained contact (spin_contact.SpinContact: sliding or rolling about the contact
+       point) -> lift-off -> free flight.
+
+The low-speed rule that turns an impact into contact is the held-speed core's
+(``flight_step.starts_contact``) with the restitution the impact used.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import replace
+
+from .events import SEGMENT_WORK, WORK_MAX
+from .flight_step import starts_contact
+from .impact import Impact
+from .params import InputError, RotorParams, check_finite, check_range
+from .report import (
+    _MODE_NAMES,
+    _SEGMENT_NAMES,
+    MODE_FREE,
+    MODE_ROLLING,
+    MODE_SLIDING,
+    STATUS_WORK_CAP,
+    StepContext,
+    StepReport,
+    WorkCapExceeded,
+)
+from .rigid import Delassus, check_well_posed, spin_impact
+from .simulator import TouchdownCore
+from .spin_contact import (
+    ContactForces,
+    HeldInputs,
+    SpinContact,
+    rolling_forces,
+    sliding_forces,
+)
+from .spin_flight import SpinFlight
+from .state import CoreState
+from .wall import ContactWorkExceeded
+
+
+class SpinCore(TouchdownCore):
+    """Rotor in a touchdown bearing with the spin as a state (module docstring).
+
+    J (kg m^2) is the polar inertia about the mass centre; Omega0 (rad/s) the initial spin.
+    Raises CrossParameterError when J is too small for the contact to be well posed."""
+
+    SPIN_STATE = True
+
+    def __init__(self, params: RotorParams, J: float, z0: complex = 0j, v0: complex = 0j,
+                 psi0: float = 0.0, Omega0: float = 0.0, t0: float = 0.0) -> None:
+        super().__init__(params, z0, v0, psi0, t0)
+        self._J = check_range("J", J, 0.0, lo_open=True, unit="kg m^2")
+        check_well_posed(params, self._J)
+        self._inputs = (check_finite("Omega0", Omega0), 0j, 1.0)
+
+    @classmethod
+    def on_steady_whirl(cls, params: RotorParams, Omega: float, F_ext: complex = 0j,
+                        amb_on: float = 1.0, psi0: float = 0.0, t0: float = 0.0,
+                        *, J: float = math.inf) -> SpinCore:
+        """Start on the held-speed steady whirl at Omega (rad/s) (TouchdownCore's)."""
+        held = TouchdownCore.on_steady_whirl(params, Omega, F_ext, amb_on, psi0, t0)
+        return cls(params, J, held.z, held.v, psi0, Omega, t0)
+
+    @property
+    def J(self) -> float:
+        """Polar inertia about the mass centre (kg m^2)."""
+        return self._J
+
+    @property
+    def Omega(self) -> float:
+        """Spin speed (rad/s), a state."""
+        return self._inputs[0]
+
+    def set_params(self, params: RotorParams) -> None:
+        """Change parameters between steps (tunables); the spin is kept."""
+        check_well_posed(params, self._J)
+        W = self._inputs[0]
+        super().set_params(params)
+        self._inputs = (W, *self._inputs[1:])
+
+    @property
+    def state(self) -> CoreState:
+        """The state as a plain record, with J set (read-only)."""
+        return replace(super().state, J=self._J)
+
+    def set_state(self, st: dict | CoreState) -> None:
+        """Restore a state of a SpinCore (J set); ParameterError otherwise, nothing
+        changes."""
+        cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
+        if cs.J is not None:
+            check_well_posed(cs.params, cs.J)
+        super().set_state(cs)
+        self._J = cs.J
+
+    # ------------------------------------------------------------------ stepping
+
+    def step(self, h: float, Omega: float | None = None, F_ext: complex = 0j,
+             amb_on: float = 1.0, budget: int | None = None, *,
+             T_drive: float = 0.0) -> StepReport:
+        """Advance by h (s) with T_drive (N m), F_ext (N) and amb_on held; ``Omega`` is
+        ignored (the spin is a state). Work bound as TouchdownCore.step."""
+        F = complex(F_ext)
+        if not (0.0 < h < math.inf and math.isfinite(T_drive) and 0.0 <= amb_on <= 1.0
+                and math.isfinite(F.real) and math.isfinite(F.imag)):
+            self._reject_inputs(h, 0.0, F, amb_on)
+            check_finite("T_drive", T_drive, InputError)
+        a = float(amb_on)
+        held = HeldInputs(self._p, self._J, a, F, float(T_drive))
+        self._inputs = (self._inputs[0], F, a)
+        cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
+        rep = StepReport(work_cap=cap)
+        t0 = self._t
+        s = self._spin_segments(h, t0, held, rep, StepContext(cap))
+        self._finish(rep, t0, s, h, True)
+        return rep
+
+    def _spin_segments(self, h: float, t0: float, held: HeldInputs, rep: StepReport,
+                       st: StepContext) -> float:
+        """The step loop: flight or contact segments until h (s) or the work bound."""
+        work, cap, s = st.work, st.cap, 0.0
+        try:
+            while s < h:
+                if work.total > cap:
+                    raise WorkCapExceeded("before the next segment")
+                work.segs += SEGMENT_WORK
+                mode = self._mode
+                if mode == MODE_FREE:
+                    s = self._spin_flight(s, h, t0, held, rep, st)
+                else:
+                    s = self._spin_contact(s, h, t0, held, rep, st)
+                if self._mode != mode:
+                    rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
+        except (WorkCapExceeded, ContactWorkExceeded) as exc:
+            work.iters += getattr(exc, "work", 0)
+            rep.status, rep.message = STATUS_WORK_CAP, (
+                f"work bound reached: {work.total} > {cap} work units; the core stopped at "
+                f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
+                f"{_SEGMENT_NAMES[self._mode]} with the spin as a state "
+                f"({len(rep.impacts)} impacts in the step): {exc}")
+        rep.work = work.total
+        return s
+
+    def _set_psi(self, psi: float) -> None:
+        """Set the spin angle from an unwrapped value psi = _psi + increment (rad)."""
+        self._add_psi(psi - self._psi)
+
+    # ------------------------------------------------------------------ flight and impacts
+
+    def _spin_flight(self, s: float, h: float, t0: float, held: HeldInputs,
+                     rep: StepReport, st: StepContext) -> float:
+        """A free-flight segment from s (s) into the step; an impact or contact at its end."""
+        rem = (h - s) - st.s_lo
+        W = self._inputs[0]
+        fl = SpinFlight(self._p, self._J, held.a, held.F_ext, held.T_drive, self._z, self._v,
+                        self._psi, W).run(rem, st.cap - st.work.total)
+        st.work.iters += fl.work
+        self._z, self._v = fl.z, fl.v
+        self._set_psi(fl.psi)
+        self._set_spin(fl.Omega)
+        if fl.event is None:
+            return h
+        s = st.later(s, min(fl.duration, rem))
+        self._at_wall(t0 + s + st.s_lo, held, rep)
+        return s
+
+    def _set_spin(self, W: float) -> None:
+        self._inputs = (W, *self._inputs[1:])
+
+    def _at_wall(self, t: float, held: HeldInputs, rep: StepReport) -> None:
+        """The flight reached the wall at t (s): an impact if it moves outward, then
+        contact if the low-speed rule says so or it touched with zero normal speed."""
+        p = self._p
+        z = self._z * (p.c_r / abs(self._z))
+        n = z / p.c_r
+        w = n.conjugate() * self._v
+        if w.real > 0.0:
+            plastic = self._spin_impact(t, z, n, w.real, w.imag, held, rep)
+        else:
+            self._z = z
+            plastic = True
+        if plastic:
+            self._enter_spin_contact(held)
+
+    def _spin_impact(self, t: float, z: complex, n: complex, rdot: float, vt: float,
+                     held: HeldInputs, rep: StepReport) -> bool:
+        """Apply the impact law at z (on the circle) to normal speed rdot > 0 and tangential
+        speed vt (m/s); True when the low-speed rule makes it plastic (contact starts)."""
+        p, W = self._p, self._inputs[0]
+        beta = self._psi + p.phi - cmath.phase(n)
+        dl = Delassus.at(p.m, self._J, p.e_c, p.R, beta)
+        vrel = p.R * W + vt
+        r = spin_impact(dl, p.mu, p.d, rdot, vrel)
+        v_minus = self._v
+        iE = 1j * p.e_c * cmath.exp(1j * (self._psi + p.phi))
+        v_plus = v_minus - complex(r.P_n, r.P_t) * n / p.m - r.dOmega * iE
+        A = self._outward_accel_spin(z, v_plus, W + r.dOmega, held)
+        plastic = starts_contact(A, r.d_eff * rdot, r.d_eff, p.c_r,
+                                 lambda: max(abs(W), abs(vt) / p.c_r, math.sqrt(A / p.c_r)))
+        if plastic:
+            r = spin_impact(dl, p.mu, 0.0, rdot, vrel)
+            v_plus = v_minus - complex(r.P_n, r.P_t) * n / p.m - r.dOmega * iE
+            d = r.d_eff
+            self._t_contact = t + (2.0 * d * rdot / ((1.0 - d) * A) if 0.0 < d < 1.0
+                                   else 0.0)
+        rep.impacts.append(Impact(t, z, v_minus, v_plus, rdot, r.P_n, r.P_t, r.stick,
+                                  r.E_diss))
+        rep.P_contact -= complex(r.P_n, r.P_t) * n
+        rep.P_n += r.P_n
+        rep.P_t += r.P_t
+        rep.E_diss += r.E_diss
+        self._n_impacts += 1
+        self._t_last, self._v_last = t, rdot
+        self._z, self._v = z, v_plus
+        self._set_spin(W + r.dOmega)
+        return plastic
+
+    def _outward_accel_spin(self, z: complex, v: complex, W: float,
+                            held: HeldInputs) -> float:
+        """Outward normal acceleration d^2|z|/dt^2 (m/s^2) at the wall of the free motion
+        from (z, v) with spin W (rad/s)."""
+        p = self._p
+        E = cmath.exp(1j * (self._psi + p.phi))
+        F = held.a * (p.bias_force - p.c * v - p.k * z) + held.F_ext
+        dW = (held.T_drive + p.e_c * (F.real * E.imag - F.imag * E.real)) / self._J
+        zdd = (F - 1j * p.m * p.g) / p.m + p.e_c * (W * W - 1j * dW) * E
+        n = z / abs(z)
+        w = n.conjugate() * v
+        return (n.conjugate() * zdd).real + w.imag * w.imag / abs(z)
+
+    # ------------------------------------------------------------------ contact
+
+    def _contact_forces(self, held: HeldInputs, s: float) -> ContactForces:
+        W = self._inputs[0]
+        if s == 0.0:
+            return rolling_forces(held, self._theta, self._psi, W)[0]
+        return sliding_forces(held, s, self._theta, self._dtheta, self._psi, W)[0]
+
+    def _enter_spin_contact(self, held: HeldInputs) -> None:
+        """Enter sustained contact from the wall state (z, v): rolling where the slip is
+        zero and rolling holds, else sliding; stay in flight if the normal force is not
+        positive."""
+        p = self._p
+        z, v = self._z, self._v
+        n = z / abs(z)
+        self._theta = cmath.phase(n)
+        self._dtheta = (n.conjugate() * v).imag / p.c_r
+        mode, s = self._contact_mode(held, p.R * self._inputs[0] + p.c_r * self._dtheta)
+        if mode == MODE_FREE:
+            self._on_wall = True
+            return
+        self._mode, self._slip = mode, s
+
+    def _contact_mode(self, held: HeldInputs, vrel: float) -> tuple[int, float]:
+        """(mode, slip sign) of the contact at the current (theta, theta', psi, Omega)."""
+        p = self._p
+        if vrel == 0.0:
+            f = self._contact_forces(held, 0.0)
+            if f.N <= 0.0:
+                return MODE_FREE, 0.0
+            if abs(f.F_t) <= p.mu * f.N:
+                return MODE_ROLLING, 0.0
+            s = 1.0 if f.F_t > 0.0 else -1.0
+        else:
+            s = 1.0 if vrel > 0.0 else -1.0
+        f = self._contact_forces(held, s)
+        return (MODE_SLIDING, s) if f.N > 0.0 else (MODE_FREE, 0.0)
+
+    def _spin_contact(self, s: float, h: float, t0: float, held: HeldInputs,
+                      rep: StepReport, st: StepContext) -> float:
+        """A contact segment from s (s) into the step; the transition at its end."""
+        rem = (h - s) - st.s_lo
+        slip = 0.0 if self._mode == MODE_ROLLING else self._slip
+        seg = SpinContact(held, slip, self._theta, self._dtheta, self._psi, self._inputs[0],
+                          self._slide_step)
+        end = seg.run(rem, st.cap - st.work.total)
+        st.work.iters += end.work
+        self._slide_step = seg.next_step
+        self._theta, self._dtheta = end.theta, end.dtheta
+        self._set_psi(end.psi)
+        self._set_spin(end.Omega)
+        rep.P_n += end.P_n
+        rep.P_t += end.P_t
+        rep.P_contact += end.P_c
+        rep.E_diss += end.E_diss
+        rep.F_n_peak = max(rep.F_n_peak, end.N_peak)
+        if end.event is None:
+            return h
+        s = st.later(s, min(end.duration, rem))
+        self._transition(end.event, held)
+        return s
+
+    def _transition(self, event: str, held: HeldInputs) -> None:
+        """Apply a contact segment's event: lift-off to flight, or a new contact mode."""
+        p = self._p
+        if event == "lift_off":
+            self._leave_wall()
+            return
+        if event == "slip_zero":
+            self._dtheta = -p.R * self._inputs[0] / p.c_r
+            mode, s = self._contact_mode(held, 0.0)
+        else:  # slip_start: rolling can no longer hold
+            f = self._contact_forces(held, 0.0)
+            mode, s = MODE_SLIDING, (1.0 if f.F_t > 0.0 else -1.0)
+        if mode == MODE_FREE:
+            self._leave_wall()
+        else:
+            self._mode, self._slip = mode, s
+
+    def _leave_wall(self) -> None:
+        """Lift-off: the contact state becomes the flight state on the circle."""
+        self._z, self._v = self._wall_state()
+        self._mode = MODE_FREE
+        self._on_wall = True
+
+
+def restore_core(st: dict | CoreState) -> TouchdownCore:
+    """A core restored from a state record or its JSON: a SpinCore when the state has J,
+    else a TouchdownCore (ParameterError for an unreadable state)."""
+    cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
+    core = TouchdownCore(cs.params) if cs.J is None else SpinCore(cs.params, cs.J)
+    core.set_state(cs)
+    return core

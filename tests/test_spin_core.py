@@ -1,0 +1,138 @@
+"""SpinCore, the rotor with its spin as a state: balances, state, work (MODEL.md §6).
+
+The balances are computed here from the core's public state (z, v, psi, Omega), not from
+its internals: T = 1/2 m |z_G'|^2 + 1/2 J Omega^2 with z_G' = v + i Omega e_c E,
+L = m Im(conj(z_G) z_G') + J Omega about the bearing centre, V = m g Im(z_G).
+"""
+
+from __future__ import annotations
+
+import cmath
+import json
+import math
+
+import pytest
+from rotortd import MODE_ROLLING, STATUS_OK, CrossParameterError, RotorParams
+from rotortd.spin_core import SpinCore, restore_core
+
+CHAPTER_G = RotorParams(g=9.81)
+J_HALF = 0.5 * CHAPTER_G.m * CHAPTER_G.R ** 2  # 0.04 kg m^2
+
+
+def _body(core: SpinCore) -> dict[str, float]:
+    p = core.params
+    E = cmath.exp(1j * (core.psi + p.phi))
+    zG = core.z + p.e_c * E
+    vG = core.v + 1j * core.Omega * p.e_c * E
+    return {
+        "T": 0.5 * p.m * abs(vG) ** 2 + 0.5 * core.J * core.Omega ** 2,
+        "L": p.m * (zG.conjugate() * vG).imag + core.J * core.Omega,
+        "V": p.m * p.g * zG.imag,
+        "psi": core.psi,
+    }
+
+
+def _run(core: SpinCore, h: float, n: int, **inputs: float) -> list[int]:
+    modes = []
+    for _ in range(n):
+        rep = core.step(h, **inputs)
+        assert rep.status == STATUS_OK, rep.message
+        modes.append(core.mode)
+    return modes
+
+
+@pytest.mark.parametrize("d", [1.0, 0.8])
+def test_conservation_scene_keeps_momentum_and_energy(d: float) -> None:
+    """mu = 0, a = 0, g = 0, F_ext = 0, T_drive = 0: the contact force is normal and passes
+    through the bearing centre, so L is conserved through impacts and contact; with d = 1
+    the energy too (MODEL.md §6). Over 1 s, to 1e-12 relative."""
+    p = RotorParams(mu=0.0, g=0.0, d=d)
+    core = SpinCore(p, J_HALF, 0.3e-3 + 0.1e-3j, 0.08 - 0.05j, 0.4, 184.2)
+    b0 = _body(core)
+    _run(core, 1e-3, 1000, amb_on=0.0)
+    b1 = _body(core)
+    assert core.n_impacts > 50
+    assert abs(b1["L"] - b0["L"]) <= 1e-12 * abs(b0["L"])
+    if d == 1.0:
+        assert core.E_diss == 0.0
+        assert abs(b1["T"] - b0["T"]) <= 1e-12 * b0["T"]
+
+
+@pytest.mark.parametrize("T_drive", [0.0, 5.0])
+def test_energy_balance_closes_through_the_drop_into_dry_whip(T_drive: float) -> None:
+    """The drop from the levitated whirl (bearing off from t = 0, gravity, the chapter's
+    rotor, J = m R^2/2): the change of T + V equals the drive's work T_drive dpsi minus
+    the dissipation, with a residual below 1e-10 of the sum of the terms' magnitudes."""
+    core = SpinCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)
+    b0 = _body(core)
+    modes = _run(core, 1e-4, 3000, amb_on=0.0, T_drive=T_drive)
+    b1 = _body(core)
+    terms = [b1["T"] - b0["T"], b1["V"] - b0["V"], -T_drive * (b1["psi"] - b0["psi"]),
+             core.E_diss]
+    assert core.n_impacts > 10 and MODE_ROLLING in modes
+    assert abs(sum(terms)) <= 1e-10 * sum(abs(x) for x in terms)
+
+
+def test_dry_whip_rolls_backward_and_stays_rolling() -> None:
+    """After the drop the rotor rolls backward round the bearing (whirl = -R Omega/c_r),
+    and stays in mode 2 at every communication point once there."""
+    core = SpinCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)
+    modes = _run(core, 1e-4, 3000, amb_on=0.0)
+    first = modes.index(MODE_ROLLING)
+    assert first < 2000 and all(m == MODE_ROLLING for m in modes[first:])
+    kin = core.kinematics()
+    p = core.params
+    assert kin.whirl_rate == pytest.approx(-p.R * core.Omega / p.c_r, rel=1e-12)
+    assert abs(kin.v_rel) <= 1e-9 * p.R * abs(core.Omega)
+
+
+def test_state_round_trip_is_bit_identical() -> None:
+    """Save mid-run (in flight and in contact), restore into a fresh core through JSON,
+    continue: every later state is identical to the last bit."""
+    core = SpinCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)
+    for n_before in (300, 900):
+        _run(core, 1e-4, n_before, amb_on=0.0, T_drive=2.0)
+        saved = json.loads(json.dumps(core.get_state()))
+        copy = restore_core(saved)
+        assert isinstance(copy, SpinCore) and copy.J == core.J
+        for _ in range(200):
+            core.step(1e-4, amb_on=0.0, T_drive=2.0)
+            copy.step(1e-4, amb_on=0.0, T_drive=2.0)
+        assert copy.get_state() == core.get_state()
+
+
+def test_held_and_spin_states_do_not_mix() -> None:
+    from rotortd import ParameterError, TouchdownCore
+
+    spin = SpinCore(RotorParams(), J_HALF, Omega0=100.0)
+    held = TouchdownCore(RotorParams())
+    with pytest.raises(ParameterError, match="restore it into a SpinCore"):
+        held.set_state(spin.get_state())
+    with pytest.raises(ParameterError, match="restore it into a TouchdownCore"):
+        spin.set_state(held.get_state())
+    v1 = held.get_state() | {"version": 1}
+    v1.pop("J")
+    assert type(restore_core(v1)) is TouchdownCore
+
+
+def test_ill_posed_inertia_is_refused() -> None:
+    p = RotorParams(mu=1.0, e_c=0.01)
+    with pytest.raises(CrossParameterError, match="J = 1e-05 kg m"):
+        SpinCore(p, 1e-5)
+
+
+def test_infinite_inertia_limit_is_the_held_speed_core() -> None:
+    """J -> infinity: the spin barely changes and the motion approaches the held-speed
+    core's (the same physics with Omega held), through impacts and sliding."""
+    from rotortd import TouchdownCore
+
+    p = RotorParams(g=9.81)
+    held = TouchdownCore.on_steady_whirl(p, 184.2)
+    spin = SpinCore.on_steady_whirl(p, 184.2, J=1e7)
+    for _ in range(300):
+        held.step(1e-4, 184.2, amb_on=0.0)
+        spin.step(1e-4, amb_on=0.0)
+    assert held.n_impacts > 3
+    assert abs(spin.z - held.z) <= 1e-5 * p.c_r
+    assert spin.Omega == pytest.approx(184.2, rel=1e-6)
+    assert math.isfinite(spin.E_diss)
