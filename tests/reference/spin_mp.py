@@ -119,12 +119,16 @@ def _law_at(w: tuple[Num, Num, Num], mu: Num, d_eff: Num, rd: Num, s: Num
 
 def mp_impact(m: float, J: float, e_c: float, R: float, mu: float, d: float, beta: float,
               rdot_minus: float, v_rel_minus: float, n: complex = 1 + 0j, v_minus: complex = 0j,
-              Omega_minus: float = 0.0, dps: int = 40) -> dict[str, Any]:
-    """The SPEC impact law in mpmath. Returns a dict with P_n, P_t [N s], v_plus [m/s],
-    Omega_plus [rad/s], stick (bool), d_eff, E_diss [J] (= -dT), rdot_plus, v_rel_plus [m/s].
+              Omega_minus: float = 0.0, dps: int = 40, cap: str = "largest") -> dict[str, Any]:
+    """The SPEC impact law in mpmath (``cap`` as in the float reference: "largest" for the
+    largest admissible d_eff in [0, d], "spec" for the SPEC's literal bisection recipe).
+    Returns a dict with P_n, P_t [N s], v_plus [m/s], Omega_plus [rad/s], stick (bool), d_eff,
+    E_diss [J] (= -dT), rdot_plus, v_rel_plus [m/s].
 
-    ``beta`` [rad] = psi + phi - theta; ``n`` unit normal; ``v_minus``, ``Omega_minus`` the
-    state before (only used for v_plus, Omega_plus). Inputs are exact binary floats.
+    ``beta`` [rad] = psi + phi - theta; ``n`` unit normal; ``v_minus`` (geometric centre's z')
+    and ``Omega_minus`` the state before (only used for v_plus, Omega_plus): the mass centre's
+    velocity changes by -(P_n + i P_t) n / m, so z' changes by that minus i e_c E dOmega,
+    E = n e^{i beta}. Inputs are exact binary floats.
     """
     with mp.workdps(dps + 10):
         M, JJ, ec, RR = (mpmath.mpf(x) for x in (m, J, e_c, R))
@@ -151,10 +155,10 @@ def mp_impact(m: float, J: float, e_c: float, R: float, mu: float, d: float, bet
             de = min(max(de, mpmath.mpf(0)), DD)
             trial = _law_at(w, MU, de, rd, s)
             same = trial[4] == kind[0] and (trial[4] or _sgn(trial[1]) == kind[1])
-            if same or trial[5] <= 0:
+            if same or (trial[5] <= 0 and cap == "spec"):
                 d_eff, res = de, trial
             else:
-                lo, hi = mpmath.mpf(0), de
+                lo, hi = (de, DD) if trial[5] <= 0 else (mpmath.mpf(0), de)
                 for _ in range(60):
                     mid = (lo + hi) / 2
                     if _law_at(w, MU, mid, rd, s)[5] <= 0:
@@ -164,8 +168,10 @@ def mp_impact(m: float, J: float, e_c: float, R: float, mu: float, d: float, bet
                 d_eff, res = lo, _law_at(w, MU, lo, rd, s)
         pn, pt, rdp, vrp, stick, dT = res
         nn = mpmath.mpc(n)
-        v_plus = mpmath.mpc(v_minus) - (pn + 1j * pt) * nn / M
-        om_plus = mpmath.mpf(Omega_minus) - (B * pn + A * pt) / JJ
+        d_om = -(B * pn + A * pt) / JJ
+        E = nn * mpmath.expj(b)
+        v_plus = mpmath.mpc(v_minus) - (pn + 1j * pt) * nn / M - 1j * ec * E * d_om
+        om_plus = mpmath.mpf(Omega_minus) + d_om
         return {"P_n": +pn, "P_t": +pt, "v_plus": +v_plus, "Omega_plus": +om_plus,
                 "stick": stick, "d_eff": +d_eff, "E_diss": -dT, "rdot_plus": +rdp,
                 "v_rel_plus": +vrp}
