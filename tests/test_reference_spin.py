@@ -330,3 +330,44 @@ def test_drop_into_dry_whip(factor: float) -> None:
     # rolling conserves energy (no slip, no bearing): check it over the rolling samples
     er = np.array([etot(k) for k in np.nonzero(roll)[0]])
     assert np.ptp(er) < 1e-12 * e0
+
+
+# -------------------------------------------------------------------------------- contact events
+def test_loop_lift_off_angle() -> None:
+    """e_c = 0, mu = 0, a = 0: a point on the inside of a vertical circle, started at the bottom
+    with v0^2 = 3.5 g c_r, slides and leaves the wall at height 1.5 c_r (theta = pi/6)."""
+    p = {**CHAPTER_G, "levitate": False, "e_c": 0.0, "mu": 0.0}
+    g = p["g"]
+    v0 = math.sqrt(3.5 * g * CR)
+    first = simulate(p, 0.04, 10.0, -1j * CR * (1 - 1e-13), v0 + 0j, 0.0, 0.03, a=0.0)
+    t_lift = next(t for t, nm in first.transitions if nm == "free")
+    assert first.transitions[0][1] == "sliding"
+    res = simulate(p, 0.04, 10.0, -1j * CR * (1 - 1e-13), v0 + 0j, 0.0, 0.03, [t_lift], a=0.0)
+    th = cmath.phase(res.samples["z"][0])
+    assert abs(th - math.pi / 6) < 1e-9, th - math.pi / 6
+
+
+def test_rolling_cone_sliding_lift_off_energy_balance() -> None:
+    """Chapter rotor, bearing off, started rolling backward at the bottom: rolling until the
+    friction cone, sliding, lift-off; T + V + E_impacts + E_friction is constant."""
+    p = {**CHAPTER_G, "levitate": False}
+    J, V = 0.5 * M * R * R, 0.15
+    grid = np.linspace(0.0, 0.05, 501)
+    res = simulate(p, J, -V / R, -1j * CR * (1 - 1e-13), V + 0j, 0.0, 0.05, grid, a=0.0)
+    names = [nm for _, nm in res.transitions]
+    assert names[:3] == ["rolling", "sliding", "free"], names
+    s = res.samples
+
+    def etot(k: int) -> float:
+        return sum(_energy(M, J, p["e_c"], p["phi"], s["z"][k], s["v"][k], s["psi"][k],
+                           s["Omega"][k], p["g"]))
+
+    e0, e1 = etot(0), etot(-1)
+    assert res.E_friction > 1e-6 * e0
+    assert abs(e1 + res.E_impacts + res.E_friction - e0) < 1e-11 * e0
+    # slip reversal in sliding at a lower speed: the slip sign flips, the rotor stays on
+    res = simulate(p, J, -0.1 / R, -1j * CR * (1 - 1e-13), 0.1 + 0j, 0.0, 0.05, grid, a=0.0)
+    names = [nm for _, nm in res.transitions]
+    assert names[:3] == ["rolling", "sliding", "sliding"] and "free" not in names, names
+    vr = res.samples["v_rel"][res.samples["mode"] == MODE_SLIDING]
+    assert vr.max() > 0.0 > vr.min()
