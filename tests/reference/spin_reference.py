@@ -538,22 +538,30 @@ class _Sim:
                 qq = f(t)
                 return float((qq[0] ** 2 + qq[1] ** 2) / c2 - 1.0)
 
+            neg = g < 0.0
             over = np.nonzero(g > _GRAZE_MARGIN)[0]
-            if over.size and over[0] > 0 and g[over[0] - 1] < 0.0:
-                i = int(over[0])
-                return float(brentq(gfun, tt[i - 1], tt[i], xtol=4 * _EPS * max(tb, 1.0)))
-            if over.size and over[0] == 0:
-                continue  # starts outside: cannot happen after a pull-in; ignore
-            curv = float(np.max(np.abs(np.diff(g, 2)))) if g.size > 2 else 0.0
-            for i in range(1, _N_SAMPLES - 1):
-                if g[i] >= g[i - 1] and g[i] >= g[i + 1] and g[i] + curv > 0.0:
-                    r = minimize_scalar(lambda t: -gfun(t), bounds=(tt[i - 1], tt[i + 1]),
-                                        method="bounded",
-                                        options={"xatol": 1e-10 * (tb - ta)})
-                    tm = float(r.x)
-                    if gfun(tm) > _GRAZE_MARGIN:
-                        return float(brentq(gfun, tt[i - 1] if g[i - 1] < 0 else ta, tm,
-                                            xtol=4 * _EPS * max(tb, 1.0)))
+            i_end = int(over[0]) if over.size else _N_SAMPLES
+            if over.size:  # a sample beyond the wall: bracket from the last one inside
+                inside = np.nonzero(neg[:i_end])[0]
+                if inside.size:
+                    i0 = int(inside[-1])
+                    i1 = i0 + 1 if g[i0 + 1] > 0.0 else i_end
+                    return float(brentq(gfun, tt[i0], tt[i1], xtol=4 * _EPS * max(tb, 1.0)))
+                continue  # the step starts on or beyond the wall: the previous step's crossing
+            # no sample beyond the wall: refine every sample maximum (ends included) that the
+            # curvature bound (largest second difference) lets reach the wall
+            curv = float(np.max(np.abs(np.diff(g, 2))))
+            for i in range(_N_SAMPLES):
+                lo, hi = max(i - 1, 0), min(i + 1, _N_SAMPLES - 1)
+                if g[i] < g[lo] or g[i] < g[hi] or g[i] + curv <= 0.0:
+                    continue
+                r = minimize_scalar(lambda t: -gfun(t), bounds=(tt[lo], tt[hi]),
+                                    method="bounded", options={"xatol": 1e-10 * (tb - ta)})
+                tm = float(r.x)
+                inside = np.nonzero(neg & (tt < tm))[0]
+                if gfun(tm) > _GRAZE_MARGIN and inside.size:
+                    return float(brentq(gfun, tt[int(inside[-1])], tm,
+                                        xtol=4 * _EPS * max(tb, 1.0)))
         return None
 
     # ---------------------------------------------------------------- sampling
