@@ -314,6 +314,7 @@ def test_drop_into_dry_whip(factor: float) -> None:
     assert res.mode == MODE_ROLLING
     assert any(i["plastic"] for i in res.impacts)  # chattering ended by the plastic rule
     s = res.samples
+    assert s["t"].size == 3001 and np.all(np.diff(s["t"]) > 0.0)  # every grid point, once
     roll = s["mode"] == MODE_ROLLING
     assert np.all(s["theta_dot"][roll] < 0.0) and np.all(s["Omega"][roll] > 0.0)  # backward
     assert np.max(np.abs(s["v_rel"][roll])) < 1e-9 * R * OMEGA0

@@ -434,6 +434,7 @@ class _Sim:
         self.atol_roll = rtol * np.array([1.0, w, 1.0, ai, ai, ai, ai, ae])
         self.res = SpinResult()
         self.gap_event = self._make_gap()
+        self.t_done = 0.0
         self.buf: dict[str, list[Any]] = {k: [] for k in
                                           ("t", "z", "v", "psi", "Omega", "mode", "theta_dot",
                                            "v_rel", "N")}
@@ -721,7 +722,10 @@ class _Sim:
             if tg is not None and tg < t_stop:
                 kind, t_stop, y_stop = 0, tg, sol.sol(tg)
         done = kind == "end"
-        self.sample(st, sol.sol, last_t, t_stop, last=done)
+        # from the previous phase's stop (a restart after an impact begins ~1e-12 s later; the
+        # dense output covers that gap to within its own accuracy)
+        self.sample(st, sol.sol, min(self.t_done, last_t), t_stop, last=done)
+        self.t_done = t_stop
         if done:
             return _St(t_stop, st.mode, np.asarray(y_stop, dtype=float), st.s), True
         if st.mode == MODE_FREE:
