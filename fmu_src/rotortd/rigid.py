@@ -29,7 +29,9 @@ from dataclasses import dataclass
 from .params import CrossParameterError, RotorParams
 
 CAP_HALVINGS = 60
-"""Bisection steps of the energetic cap when its closed form changes the impact's kind."""
+"""Bisection steps of the energetic cap when the impact's kind (stick, or the slide's
+direction) at the closed form's restitution differs from the kind at d: the largest
+restitution without gain is then bracketed between the two."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -126,11 +128,12 @@ def spin_impact(w: Delassus, mu: float, d: float, rdot: float, vrel: float) -> S
     d_eff = d
     dT = _gain(Pn, Pt, rdot, d, vrel, vp)
     if dT > 0.0:  # Newton's restitution would create energy: cap it
+        kind = (stick, Pt > 0.0)
         d_eff = _capped_restitution(w, mu, d, rdot, vrel, stick, Pt)
         Pn, Pt, vp, stick = _outcome(w, mu, d_eff, rdot, vrel)
         dT = _gain(Pn, Pt, rdot, d_eff, vrel, vp)
-        if dT > 0.0:  # the kind changed at the closed form's root: bisect
-            lo, hi = 0.0, d_eff
+        if (stick, Pt > 0.0) != kind:  # the kind changed at the closed form's root:
+            lo, hi = (d_eff, d) if dT <= 0.0 else (0.0, d_eff)  # bisect for the largest
             for _ in range(CAP_HALVINGS):
                 mid = 0.5 * (lo + hi)
                 o = _outcome(w, mu, mid, rdot, vrel)
