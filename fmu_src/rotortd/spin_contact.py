@@ -20,16 +20,17 @@ centre, the contact force -(N + i F_t) n obeys
 Both are integrated by Gragg-Bulirsch-Stoer extrapolation (``gbs``) at RTOL = 1e-13 per
 step on every component, the contact impulses (int N, int F_t, int F_c) and the friction
 dissipation (int mu N |v_rel|) carried as error-controlled quadratures. The step is capped
-at H_FRACTION of the fastest rotation (theta', Omega, beta'), so that an event function
-(N, v_rel, mu N - |F_t|) that changes sign is seen at a step end; a sign change is located
-by re-integrating the step with its column count fixed (regula falsi, to the resolution of
-the time). Events: "lift_off" (N reaches 0), "slip_zero" (v_rel reaches 0 in sliding),
-"slip_start" (|F_t| reaches mu N in rolling).
+at H_FRACTION (one radian) of the fastest rotation (theta', Omega, beta'), and the event
+functions (N, v_rel, mu N - |F_t|) are checked at each step's end and at its midpoint (the
+cubic Hermite interpolant of the state from both ends' values and slopes), so a sign change
+is seen unless it starts and ends within half a step; it is then located by re-integrating
+the step with its column count fixed (Illinois regula falsi, to 4 ulp of the time).
+Events: "lift_off" (N reaches 0), "slip_zero" (v_rel reaches 0 in sliding), "slip_start"
+(|F_t| reaches mu N in rolling).
 """
 
 from __future__ import annotations
 
-import cmath
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -40,7 +41,7 @@ from .wall import ContactWorkExceeded
 
 RTOL = 1e-13
 """Relative tolerance per extrapolated step, every component."""
-H_FRACTION = 0.25
+H_FRACTION = 1.0
 """Largest step, in radians of the fastest rotation of the contact (theta', Omega, beta')."""
 STEP_WORK = 8
 """Work units per extrapolated step beyond its right-hand sides (as sliding.GBS_STEP_WORK)."""
@@ -93,45 +94,69 @@ class SpinSegmentEnd:
     work: int
 
 
-def _known(h: HeldInputs, theta: float, dtheta: float, psi: float, Omega: float
-           ) -> tuple[complex, float, float, float, float, float, float]:
-    """(n, B, A, rhs_n, F_ot, T, cos beta) at a contact state: rhs_n = Re(conj(n) F_o)
-    + m c_r theta'^2 (N), F_ot = Im(conj(n) F_o) (N), T = T_drive + T_o (N m)."""
-    p = h.p
-    n = cmath.exp(1j * theta)
-    E = cmath.exp(1j * (psi + p.phi))
-    z = p.c_r * n
-    v = 1j * p.c_r * dtheta * n
-    F = h.a * (p.bias_force - p.c * v - p.k * z) + h.F_ext
-    T = h.T_drive + p.e_c * (F.real * E.imag - F.imag * E.real)
-    Fo = (F - 1j * p.m * p.g + p.m * p.e_c * Omega * Omega * E) * n.conjugate()
-    eb = E * n.conjugate()
-    B = p.e_c * eb.imag
-    A = p.R - p.e_c * eb.real
-    return n, B, A, Fo.real + p.m * p.c_r * dtheta * dtheta, Fo.imag, T, eb.real
+class ContactModel:
+    """The held inputs as plain floats, and the contact's forces at a state in real
+    arithmetic (SI; one cos/sin pair each for theta and psi + phi)."""
+
+    __slots__ = ("J", "R", "T", "ac", "ak", "c_r", "e_c", "fx", "fy", "m", "mg", "mu", "phi")
+
+    def __init__(self, h: HeldInputs) -> None:
+        p = h.p
+        F1 = h.a * p.bias_force + h.F_ext  # the constant forces at the geometric centre (N)
+        self.m, self.c_r, self.R, self.e_c, self.phi = p.m, p.c_r, p.R, p.e_c, p.phi
+        self.mu, self.J, self.T, self.mg = p.mu, h.J, h.T_drive, p.m * p.g
+        self.ac, self.ak = h.a * p.c, h.a * p.k
+        self.fx, self.fy = F1.real, F1.imag
+
+    def _known(self, ct: float, st: float, dtheta: float, psi: float, Omega: float
+               ) -> tuple[float, float, float, float, float, float]:
+        """(B, A, rhs_n, F_ot, T, cos beta) at the contact state with n = ct + i st:
+        rhs_n = Re(conj(n) F_o) + m c_r theta'^2 (N), F_ot = Im(conj(n) F_o) (N),
+        T = T_drive + T_o (N m)."""
+        c_r, e_c, m = self.c_r, self.e_c, self.m
+        ang = psi + self.phi
+        cE, sE = math.cos(ang), math.sin(ang)
+        w, ck, ca = c_r * dtheta, c_r * self.ak, self.ac
+        Fr = self.fx + ca * w * st - ck * ct  # F_amb + F_ext, z = c_r n, v = i c_r theta' n
+        Fi = self.fy - ca * w * ct - ck * st
+        T = self.T + e_c * (Fr * sE - Fi * cE)
+        u = m * e_c * Omega * Omega
+        Gr, Gi = Fr + u * cE, Fi - self.mg + u * sE  # F_o
+        cb, sb = cE * ct + sE * st, sE * ct - cE * st  # e^{i beta} = conj(n) E
+        return (e_c * sb, self.R - e_c * cb, Gr * ct + Gi * st + m * c_r * dtheta * dtheta,
+                Gi * ct - Gr * st, T, cb)
+
+    def sliding(self, s: float, theta: float, dtheta: float, psi: float, Omega: float
+                ) -> tuple[float, float, float, float, float, float]:
+        """(N, F_t, theta'', Omega', cos theta, sin theta) of sliding with slip sign s."""
+        ct, st = math.cos(theta), math.sin(theta)
+        B, A, rn, Fot, T, cb = self._known(ct, st, dtheta, psi, Omega)
+        m, mus = self.m, self.mu * s
+        k = B + mus * A
+        dW = (T - k * rn) / (self.J + m * B * k)
+        N = rn + m * B * dW
+        Ft = mus * N
+        return N, Ft, (Fot - Ft - m * self.e_c * cb * dW) / (m * self.c_r), dW, ct, st
+
+    def rolling(self, theta: float, psi: float, Omega: float
+                ) -> tuple[float, float, float, float, float, float]:
+        """(N, F_t, theta'', Omega', cos theta, sin theta) of rolling (theta' = -R Omega/c_r)."""
+        ct, st = math.cos(theta), math.sin(theta)
+        B, A, rn, Fot, T, _ = self._known(ct, st, -self.R * Omega / self.c_r, psi, Omega)
+        m = self.m
+        dW = (T - B * rn - A * Fot) / (self.J + m * (A * A + B * B))
+        return rn + m * B * dW, Fot + m * A * dW, -self.R * dW / self.c_r, dW, ct, st
 
 
 def sliding_forces(h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
-                   Omega: float) -> tuple[ContactForces, complex]:
-    """The forces of sliding with slip sign s at a state, and the normal n."""
-    p = h.p
-    n, B, A, rn, Fot, T, cb = _known(h, theta, dtheta, psi, Omega)
-    k = B + p.mu * s * A
-    dW = (T - k * rn) / (h.J + p.m * B * k)
-    N = rn + p.m * B * dW
-    Ft = p.mu * s * N
-    dd = (Fot - Ft - p.m * p.e_c * cb * dW) / (p.m * p.c_r)
-    return ContactForces(N, Ft, dd, dW), n
+                   Omega: float) -> ContactForces:
+    """The forces of sliding with slip sign s at a state."""
+    return ContactForces(*ContactModel(h).sliding(s, theta, dtheta, psi, Omega)[:4])
 
 
-def rolling_forces(h: HeldInputs, theta: float, psi: float, Omega: float
-                   ) -> tuple[ContactForces, complex]:
-    """The forces of rolling (v_rel = 0, theta' = -R Omega/c_r) at a state, and n."""
-    p = h.p
-    dtheta = -p.R * Omega / p.c_r
-    n, B, A, rn, Fot, T, _ = _known(h, theta, dtheta, psi, Omega)
-    dW = (T - B * rn - A * Fot) / (h.J + p.m * (A * A + B * B))
-    return ContactForces(rn + p.m * B * dW, Fot + p.m * A * dW, -p.R * dW / p.c_r, dW), n
+def rolling_forces(h: HeldInputs, theta: float, psi: float, Omega: float) -> ContactForces:
+    """The forces of rolling (v_rel = 0, theta' = -R Omega/c_r) at a state."""
+    return ContactForces(*ContactModel(h).rolling(theta, psi, Omega)[:4])
 
 
 class SpinContact:
@@ -141,17 +166,19 @@ class SpinContact:
     def __init__(self, h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
                  Omega: float, step0: float = math.inf) -> None:
         self.h, self.s = h, s
+        self.model = ContactModel(h)
         p = h.p
+        self.dth_per_W = -p.R / p.c_r
         self.rolling = s == 0.0
         self.y0: Vector = ([theta, psi, Omega] if self.rolling
                            else [theta, dtheta, psi, Omega])
         self.nq = len(self.y0)
-        f, _ = self._forces(self.y0)
+        N0 = self._forces(self.y0)[0]
         w = max(abs(dtheta), abs(Omega), abs(dtheta - Omega),
-                math.sqrt(abs(f.N) / (p.m * p.c_r)), math.sqrt(p.k / p.m), 1.0)
+                math.sqrt(abs(N0) / (p.m * p.c_r)), math.sqrt(p.k / p.m), 1.0)
         self.h_max = H_FRACTION / w
-        self.step0 = min(step0, 0.1 * self.h_max)
-        Fs = max(abs(f.N) * (1.0 + p.mu), p.m * p.c_r * w * w)
+        self.step0 = min(step0, self.h_max) if step0 < math.inf else 0.1 * self.h_max
+        Fs = max(abs(N0) * (1.0 + p.mu), p.m * p.c_r * w * w)
         Ws = max(abs(Omega), p.c_r * w / p.R)
         self.tol_state = ([RTOL * (1.0 + abs(theta)), RTOL * (1.0 + abs(psi)), RTOL * Ws]
                           if self.rolling else
@@ -160,30 +187,30 @@ class SpinContact:
         self.tol_rate = [RTOL * Fs] * 4 + [RTOL * Fs * (p.R * Ws + p.c_r * w)]
         """Tolerance per second of step of the quadratures int N, int F_t, int F_c, E_diss."""
 
-    def _forces(self, y: Vector) -> tuple[ContactForces, complex]:
+    def _forces(self, y: Vector) -> tuple[float, float, float, float, float, float]:
         if self.rolling:
-            return rolling_forces(self.h, y[0], y[1], y[2])
-        return sliding_forces(self.h, self.s, y[0], y[1], y[2], y[3])
+            return self.model.rolling(y[0], y[1], y[2])
+        return self.model.sliding(self.s, y[0], y[1], y[2], y[3])
 
     def rhs(self, _u: float, y: Vector) -> Vector:
         """d/du of the state and of (int N, int F_t, Re int F_c, Im int F_c, E_diss)."""
-        f, n = self._forces(y)
-        Fc = -(f.N + 1j * f.F_t) * n
         if self.rolling:
-            p = self.h.p
-            return [-p.R * y[2] / p.c_r, y[2], f.dOmega, f.N, f.F_t, Fc.real, Fc.imag, 0.0]
-        vrel = self.h.p.R * y[3] + self.h.p.c_r * y[1]
-        return [y[1], f.ddtheta, y[3], f.dOmega, f.N, f.F_t, Fc.real, Fc.imag,
-                abs(f.F_t * vrel)]
+            N, Ft, _, dW, ct, st = self.model.rolling(y[0], y[1], y[2])
+            return [self.dth_per_W * y[2], y[2], dW, N, Ft,
+                    Ft * st - N * ct, -N * st - Ft * ct, 0.0]
+        N, Ft, dd, dW, ct, st = self.model.sliding(self.s, y[0], y[1], y[2], y[3])
+        vrel = self.model.R * y[3] + self.model.c_r * y[1]
+        return [y[1], dd, y[3], dW, N, Ft, Ft * st - N * ct, -N * st - Ft * ct,
+                abs(Ft * vrel)]
 
     def events(self, y: Vector) -> list[tuple[str, float]]:
         """The event functions at y, each positive while the segment lasts: N (lift-off),
         and in rolling mu N - |F_t| (slip start), in sliding s v_rel (slip zero)."""
-        f, _ = self._forces(y)
+        N, Ft = self._forces(y)[:2]
         if self.rolling:
-            return [("lift_off", f.N), ("slip_start", self.h.p.mu * f.N - abs(f.F_t))]
-        vrel = self.h.p.R * y[3] + self.h.p.c_r * y[1]
-        return [("lift_off", f.N), ("slip_zero", vrel * self.s)]
+            return [("lift_off", N), ("slip_start", self.model.mu * N - abs(Ft))]
+        vrel = self.model.R * y[3] + self.model.c_r * y[1]
+        return [("lift_off", N), ("slip_zero", vrel * self.s)]
 
     def _margin(self, y: Vector) -> float:
         """The least event function (continuous; its first zero is the first event)."""
@@ -196,7 +223,10 @@ class SpinContact:
     def run(self, rem: float, limit: int) -> SpinSegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
         y = self.y0 + [0.0] * 5
-        u, H, work, N_peak = 0.0, self.step0, 0, abs(self._forces(self.y0)[0].N)
+        nq = self.nq
+        u, H, work = 0.0, self.step0, 0
+        f0 = self.rhs(u, y)
+        N_peak = abs(f0[nq])
         sweep = self._sweep()
         event = None
         while u < rem:
@@ -205,32 +235,50 @@ class SpinContact:
                     f"{'rolling' if self.rolling else 'sliding'} with the spin as a state: "
                     f"{work} work units in {u!r} s", work)
             Hs = min(H, self.h_max, rem - u)
-            f0 = self.rhs(u, y)
             scale = self.tol_state + [t * Hs + RTOL * abs(q)
-                                      for t, q in zip(self.tol_rate, y[self.nq:])]
+                                      for t, q in zip(self.tol_rate, y[nq:])]
             y1, err, k, nfev = gbs.extrapolated_step(sweep, u, y, f0, Hs, scale, k_min=4)
             work += nfev + STEP_WORK
             if not err <= 1.0:
                 H = 0.25 * Hs if err != err else gbs.next_step_size(Hs, err, k)
                 continue
-            if self._margin(y1) <= 0.0:
-                tau, y1, w2 = self._locate(sweep, u, y, f0, Hs, k, scale)
+            f1 = self.rhs(u + Hs, y1)
+            work += 2
+            hit = self._event_in_step(sweep, u, y, f0, y1, f1, Hs, k, scale)
+            if hit is not None:
+                tau, y, w2 = hit
                 work += w2
-                u, y = u + tau, y1
+                u += tau
                 event = min(self.events(y), key=lambda e: e[1])[0]
-                N_peak = max(N_peak, abs(self._forces(y)[0].N))
+                N_peak = max(N_peak, abs(self._forces(y)[0]))
                 break
             u = rem if Hs == rem - u else u + Hs
-            y = y1
-            N_peak = max(N_peak, abs(self._forces(y)[0].N))
+            y, f0 = y1, f1
+            N_peak = max(N_peak, abs(f1[nq]))
             H = gbs.next_step_size(Hs, err, k)
         self.next_step = H
         return self._end(u, y, event, N_peak, work)
 
+    def _event_in_step(self, sweep: Callable[..., Vector], u: float, y: Vector, f0: Vector,
+                       y1: Vector, f1: Vector, Hs: float, k: int, scale: Vector
+                       ) -> tuple[float, Vector, int] | None:
+        """An event in the accepted step (0, Hs]: the least event function negative at its
+        end, or at its midpoint by the cubic Hermite interpolant of the state (a dip that
+        returns by the end), then located; None if there is none."""
+        if self._margin(y1) <= 0.0:
+            return self._locate(sweep, u, y, f0, Hs, k, scale)
+        nq = self.nq
+        mid = [0.5 * (a + b) + 0.125 * Hs * (fa - fb)
+               for a, b, fa, fb in zip(y[:nq], y1[:nq], f0[:nq], f1[:nq])]
+        if self._margin(mid) <= 0.0:
+            return self._locate(sweep, u, y, f0, 0.5 * Hs, k, scale)
+        return None
+
     def _locate(self, sweep: Callable[..., Vector], u: float, y: Vector, f0: Vector,
-                Hs: float, k: int, scale: Vector) -> tuple[float, Vector, int]:
-        """The first zero of the event function in (0, Hs] by regula falsi (Illinois) on
-        the step re-integrated with k columns; returns (tau, state there, work)."""
+                b: float, k: int, scale: Vector) -> tuple[float, Vector, int] | None:
+        """The first zero of the event function in (0, b] by regula falsi (Illinois) on
+        the step re-integrated with k columns: (tau, state there, work); None when the
+        function is positive at b after all (a midpoint estimate that was wrong)."""
         work = 0
 
         def at(tau: float) -> tuple[Vector, float]:
@@ -240,8 +288,9 @@ class SpinContact:
             return yt, self._margin(yt)
 
         a, fa = 0.0, self._margin(y)
-        b = Hs
         yb, fb = at(b)
+        if fb > 0.0:
+            return None
         side = 0
         for _ in range(ROOT_ITERS):
             if b - a <= 4.0 * math.ulp(u + b) or fb == 0.0:

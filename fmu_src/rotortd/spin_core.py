@@ -247,8 +247,8 @@ class SpinCore(TouchdownCore):
     def _contact_forces(self, held: HeldInputs, s: float) -> ContactForces:
         W = self._inputs[0]
         if s == 0.0:
-            return rolling_forces(held, self._theta, self._psi, W)[0]
-        return sliding_forces(held, s, self._theta, self._dtheta, self._psi, W)[0]
+            return rolling_forces(held, self._theta, self._psi, W)
+        return sliding_forces(held, s, self._theta, self._dtheta, self._psi, W)
 
     def _enter_spin_contact(self, held: HeldInputs) -> None:
         """Enter sustained contact from the wall state (z, v): rolling where the slip is
