@@ -424,3 +424,21 @@ def test_drop_recorder_summary_normalises_the_slip():
     assert s["Omega_mean"] == 100.0 and s["whirl_mean"] == -2000.0
     assert s["slip_ratio"] == pytest.approx(0.05 / 4.0)  # R Omega = 4 > c_r theta' = 1.4
     assert s["contact_frac"] == pytest.approx(1.0) and s["regime"] == "backward-whirl"
+
+
+def test_drop_map_draws_from_a_drop_store(tmp_path):
+    """sweep-plot of a two-parameter drop sweep draws the outcome map (no simulation: the
+    rows are hand-made; two outcomes, a whip speed, a spin kept)."""
+    from rotortd_tools.sweep_plot import drop_map
+
+    mu, J = np.array([0.05, 0.5, 0.05, 0.5]), np.array([1e-3, 1e-3, 1.0, 1.0])
+    cols = {"mu": mu, "J": J, "Omega": np.full(4, 184.2), "start": np.array(["drop"] * 4),
+            "regime": np.array(["impacting", "settled", "impacting", "dry-whip"]),
+            "whirl_mean": np.array([10.0, 0.5, 100.0, -9000.0]),
+            "Omega_mean": np.array([10.0, 0.1, 180.0, 170.0])}
+    fig = drop_map(cols, ["mu", "J"], {}, {"mu": True, "J": True})
+    assert [ax.get_xscale() for ax in fig.axes[:3]] == ["log"] * 3
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert texts == ["impacting", "settled", "dry-whip"]
+    fig.savefig(tmp_path / "m.png")
+    assert (tmp_path / "m.png").stat().st_size > 10_000
