@@ -294,3 +294,151 @@ def test_sweep_plot_1d_2d_and_chapter_events(tmp_path):
     assert (tmp_path / "a.png").stat().st_size > 10_000
     assert (tmp_path / "b.png").stat().st_size > 10_000
     assert main(["sweep-plot", str(tmp_path / "none"), "-o", str(tmp_path / "c.png")]) == 2
+
+
+# --------------------------------------------------------------------------- spin as a state
+
+
+def test_grammar_accepts_J_T_drive_and_geometric_grids():
+    spec = sw.parse_spec(["mu=0.02:0.5:log3", "J=3.2e-4:1.6:log4", "T_drive=0.5"], "drop")
+    assert spec.names == ("mu", "J") and dict(spec.fixed) == {"T_drive": 0.5}
+    assert spec.axes[0].log and spec.axes[1].log and not spec.axes[0].random
+    assert spec.axes[0].values == pytest.approx((0.02, 0.1, 0.5))
+    assert spec.axes[1].values[0] == 3.2e-4 and spec.axes[1].values[-1] == 1.6
+    assert sw.spin_inputs(spec.values_of(spec.points()[1])) == (3.2e-4, 0.5)
+    assert sw.spin_inputs({"gamma": 0.1}) == (None, 0.0)
+    assert sw.parse_spec(["J=0.04"], "rest,steady,large,up").fixed == (("J", 0.04),)
+    assert sw.parse_spec(["J=0.04", "T_drive=-2:2:3"], "rest").names == ("T_drive",)
+
+
+@pytest.mark.parametrize(
+    ("tokens", "starts", "fragment"),
+    [
+        (["T_drive=1"], "rest", "T_drive needs J"),
+        (["J=0"], "rest", "J: value 0.0 is out of range (0, inf)"),
+        (["J=-1:1:3"], "rest", "J: lower end -1.0 is out of range"),
+        (["mu=0.5", "J=1e-4:1:log3"], "drop", "too small"),  # bound 3.02e-4 at mu = 0.5
+        (["mu=0:0.5:log3"], "rest", "geometric grid '0:0.5:log3' needs a lower end > 0"),
+        (["J=0.01:1:logx"], "rest", "not an integer"),
+        (["J=0.04"], "up:drop", "a drop cannot seed a continuation"),
+    ],
+)
+def test_grammar_refuses_bad_spin_specifications(tokens, starts, fragment):
+    with pytest.raises(sw.SweepError) as err:
+        sw.parse_spec(tokens, starts)
+    assert fragment in str(err.value)
+
+
+def test_drop_settings_are_validated(capsys, tmp_path):
+    sw.Settings(drop_time=0.3, drop_window=0.3, drop_step=1e-4).validate()
+    for bad in ({"drop_time": 0.0}, {"drop_window": 0.5}, {"drop_step": 0.2}):
+        with pytest.raises(sw.SweepError, match=next(iter(bad))):
+            sw.Settings(**bad).validate()
+    rc = main(["sweep", "J=0.04", "--starts", "drop", "--drop-window", "1",
+               "--out", str(tmp_path / "o")])
+    assert rc == 2 and "drop_window" in capsys.readouterr().err
+
+
+DROP = sw.Settings(drop_time=0.15, drop_window=0.03, drop_step=1e-4)
+
+
+def test_two_point_drop_sweep_with_J_records_outcomes(tmp_path):
+    """mu = 0.15, J = 0.04 and 1.6 kg m^2: both drops end in dry whip; the whip speed is
+    the rolling relation theta' = -R Omega / c_r, and the heavier spin keeps more speed."""
+    spec = sw.parse_spec(["J=0.04:1.6:log2", "mu=0.15"], "drop")
+    counts = sw.run_sweep(spec, DROP, tmp_path / "d", serial=True)
+    assert counts == {"total": 2, "resumed": 0, "computed": 2}
+    rows = sorted(_rows_by_key(tmp_path / "d").values(), key=lambda r: r["J"])
+    assert [r["J"] for r in rows] == [0.04, 1.6] and [r["T_drive"] for r in rows] == [0, 0]
+    p = sw.point_params({})[0]
+    for r in rows:
+        assert r["status"] == "ok" and r["regime"] == "dry-whip", r
+        assert r["regime"] in sw.DROP_OUTCOMES and r["final_mode"] == MODE_ROLLING
+        assert r["roll_frac"] == pytest.approx(1.0) and r["slip_ratio"] < 1e-9
+        assert r["whirl_mean"] == pytest.approx(-p.R * r["Omega_mean"] / p.c_r, rel=1e-3)
+        assert 0.0 < r["Omega_mean"] < r["Omega"] and r["Omega_end"] > 0.0
+    assert rows[1]["Omega_mean"] > 2.0 * rows[0]["Omega_mean"]
+    meta = sw.read_meta(tmp_path / "d")
+    assert meta["format"] == sw.FORMAT_VERSION == 2 and meta["axes"][0]["log"] is True
+
+
+def test_spin_state_runs_without_drop_and_held_rows_have_no_J():
+    """J with a named start runs a SpinCore: the drive torque moves the spin; without J
+    the parameters J and T_drive are NaN and the spin stays held."""
+    short = sw.Settings(transient=20.0, record=10.0)
+    vals = (("J", 0.04), ("T_drive", 5.0))
+    neg = (("J", 0.04), ("T_drive", -5.0))
+    up = sw.run_job(sw.Job(0, vals, vals, "steady"), short)[0]
+    down = sw.run_job(sw.Job(0, neg, neg, "steady"), short)[0]
+    assert up["status"] == down["status"] == "ok" and up["regime"] == "free"
+    assert up["Omega_end"] > up["Omega"] > down["Omega_end"]
+    assert math.isnan(up["Omega_mean"]) and json.loads(up["final_state"])["J"] == 0.04
+    held = _run(0.3, "steady", short)
+    assert math.isnan(held["J"]) and math.isnan(held["T_drive"])
+    assert held["Omega_end"] == held["Omega"]
+
+
+def test_old_store_format_is_read_but_not_resumed(tmp_path):
+    spec = sw.parse_spec(["gamma=0.1:0.2:2"], "steady")
+    sw.run_sweep(spec, SHORT, tmp_path / "o", serial=True)
+    meta = sw.read_meta(tmp_path / "o")
+    meta["format"] = 1
+    (tmp_path / "o" / sw.META_FILE).write_text(json.dumps(meta))
+    assert len(sw.read_sweep(tmp_path / "o")["key"]) == 2
+    with pytest.raises(sw.SweepError, match=r"store format 1.*read .*not resumed"):
+        sw.run_sweep(spec, SHORT, tmp_path / "o", serial=True)
+
+
+def _drop(n=0, slide=0.0, roll=0.0, W=100.0, whirl=-5000.0, ratio=0.0, tw=0.1):
+    return sw.classify_drop(n, slide, roll, W, whirl, ratio, tw)
+
+
+def test_classify_drop_classes_and_threshold_boundaries():
+    from rotortd_tools.attractor import SLIP_ROLL, WHIRL_TURNS
+
+    turn = 2.0 * math.pi * WHIRL_TURNS / 0.1  # whirl rate of one turn in the 0.1 s window
+    assert _drop(0, 0.0, 0.0) == "no-contact"
+    assert _drop(1, 0.0, 0.0) == "impacting"
+    assert _drop(0, 0.01, 0.0) == "impacting"  # touched without impact: not no-contact
+    assert _drop(30, 0.2, 0.2999) == "impacting"  # contact just below half the window
+    assert _drop(30, 0.2, 0.3) == "dry-whip"  # contact at half the window: sustained
+    assert _drop(0, 1.0, 0.0, whirl=150.0, ratio=0.9) == "forward-rub"
+    assert _drop(0, 1.0, 0.0, whirl=-3000.0, ratio=0.2) == "backward-whirl"
+    assert _drop(0, 0.0, 1.0, whirl=-3000.0, ratio=0.0) == "dry-whip"
+    assert _drop(0, 0.5, 0.5, whirl=-3000.0, ratio=SLIP_ROLL) == "dry-whip"
+    assert _drop(0, 0.5, 0.5, whirl=-3000.0, ratio=SLIP_ROLL * 1.001) == "backward-whirl"
+    assert _drop(0, 0.0, 1.0, whirl=-turn * 0.999) == "settled"  # rocking at the bottom
+    assert _drop(0, 0.0, 1.0, whirl=turn * 0.999, ratio=0.5) == "settled"
+    assert _drop(0, 0.0, 1.0, whirl=-turn * 1.001) == "dry-whip"
+    assert _drop(0, 1.0, 0.0, whirl=turn * 1.001, ratio=0.5) == "forward-rub"
+    # the whirl's sense is taken against the spin: a reversed spin rolling forward whips
+    assert _drop(0, 0.0, 1.0, W=-4.0, whirl=230.0) == "dry-whip"
+    assert _drop(0, 1.0, 0.0, W=-4.0, whirl=-230.0, ratio=0.5) == "forward-rub"
+    assert _drop(0, 1.0, 0.0, W=0.0, whirl=230.0, ratio=0.5) == "forward-rub"
+
+
+def test_drop_recorder_summary_normalises_the_slip():
+    rec = sw.DropRecorder(t_window=0.1, n_impacts=0, t_slide=0.1, n=4, sum_Omega=400.0,
+                          sum_whirl=-4 * 2000.0, sum_slip=4 * 0.05)
+    s = rec.summary(R=0.04, c_r=7e-4)
+    assert s["Omega_mean"] == 100.0 and s["whirl_mean"] == -2000.0
+    assert s["slip_ratio"] == pytest.approx(0.05 / 4.0)  # R Omega = 4 > c_r theta' = 1.4
+    assert s["contact_frac"] == pytest.approx(1.0) and s["regime"] == "backward-whirl"
+
+
+def test_drop_map_draws_from_a_drop_store(tmp_path):
+    """sweep-plot of a two-parameter drop sweep draws the outcome map (no simulation: the
+    rows are hand-made; two outcomes, a whip speed, a spin kept)."""
+    from rotortd_tools.sweep_plot import drop_map
+
+    mu, J = np.array([0.05, 0.5, 0.05, 0.5]), np.array([1e-3, 1e-3, 1.0, 1.0])
+    cols = {"mu": mu, "J": J, "Omega": np.full(4, 184.2), "start": np.array(["drop"] * 4),
+            "regime": np.array(["impacting", "settled", "impacting", "dry-whip"]),
+            "whirl_mean": np.array([10.0, 0.5, 100.0, -9000.0]),
+            "Omega_mean": np.array([10.0, 0.1, 180.0, 170.0])}
+    fig = drop_map(cols, ["mu", "J"], {}, {"mu": True, "J": True})
+    assert [ax.get_xscale() for ax in fig.axes[:3]] == ["log"] * 3
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert texts == ["impacting", "settled", "dry-whip"]
+    fig.savefig(tmp_path / "m.png")
+    assert (tmp_path / "m.png").stat().st_size > 10_000

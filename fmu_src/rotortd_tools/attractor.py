@@ -6,7 +6,12 @@ and rates are scaled, impact normal speeds in c_r Omega, angles in rad, co-rotat
 transient and then a record window with a ``Recorder``, which takes the impacts and the
 exact contact transition times from the core's step reports (the step length only sets
 the sampling of r). ``classify`` names the regime from the window (docs/sweeps.md):
-"at least half the window" is ``>= 0.5``.
+"at least half the window" is ``>= 0.5``. A ``SpinCore`` (the spin as a state) is stepped
+with its held drive torque ``T_drive`` (N m); its spin is then the core's own.
+
+The drop (``run_drop``, SI units, seconds): the bearing off (amb_on = 0) for a fixed number
+of steps, the last ones recorded by a ``DropRecorder``; ``classify_drop`` names the outcome
+(no-contact, impacting, settled, forward-rub, backward-whirl, dry-whip; docs/sweeps.md).
 """
 
 from __future__ import annotations
@@ -21,6 +26,17 @@ from rotortd import MODE_FREE, MODE_ROLLING, MODE_SLIDING, STATUS_OK, TouchdownC
 
 CHAPTER_REGIMES = ("free whirl", "impacting", "rub/sliding", "dry whip/rolling")
 """The chapter's coarse regimes (``chapter_regime``)."""
+MOST = 0.5
+""""At least half the window" (``>= MOST``): the fraction rule of ``classify``."""
+DROP_OUTCOMES = ("no-contact", "impacting", "settled", "forward-rub", "backward-whirl",
+                 "dry-whip")
+"""The drop outcomes of ``classify_drop``, in the order they are tested."""
+SLIP_ROLL = 0.01
+"""Largest slip ratio (mean |v_rel| over the larger of R |Omega| and c_r |theta'|) of a
+dry whip; above it a backward whirl is sliding."""
+WHIRL_TURNS = 1.0
+"""Fewest turns round the bearing (|mean theta'| window / 2 pi) of a whirl; below it the
+rotor in contact is ``settled`` (lying or rocking at the bottom)."""
 
 
 @dataclass
@@ -37,12 +53,19 @@ class Recorder:
     angles: list[float] = field(default_factory=list)
     speeds: list[float] = field(default_factory=list)
 
-    def step(self, core: TouchdownCore, h: float, Omega: float, t_rec0: float) -> int:
-        """Advance the core by h (s) and record; return the step status."""
+    def step(self, core: TouchdownCore, h: float, Omega: float, t_rec0: float,
+             T_drive: float | None = None) -> int:
+        """Advance the core by h (s) and record; return the step status. With ``T_drive``
+        (N m) the core is a SpinCore: the impact angles use its spin at the step start."""
         t0, psi0, mode = core.t, math.remainder(core.psi, 2.0 * math.pi), core.mode
-        rep = core.step(h, Omega)
+        if T_drive is None:
+            W = Omega
+            rep = core.step(h, Omega)
+        else:
+            W = core.Omega  # type: ignore[attr-defined]
+            rep = core.step(h, T_drive=T_drive)  # type: ignore[call-arg]
         for imp in rep.impacts:
-            ang = cmath.phase(imp.z) - (psi0 + Omega * (imp.t - t0))
+            ang = cmath.phase(imp.z) - (psi0 + W * (imp.t - t0))
             self.times.append((imp.t - t_rec0) * Omega)
             self.angles.append(math.remainder(ang, 2.0 * math.pi))
             self.speeds.append(imp.rdot / (self.c_r * Omega))
@@ -67,18 +90,21 @@ _MODE_OF = {"sliding": MODE_SLIDING, "rolling": MODE_ROLLING, "lift_off": MODE_F
 
 
 def run_to_attractor(core: TouchdownCore, Omega: float, h: float, n_transient: int,
-                     n_record: int) -> tuple[Recorder | None, str]:
+                     n_record: int, T_drive: float | None = None
+                     ) -> tuple[Recorder | None, str]:
     """Step ``core`` n_transient times by h (s) at Omega (rad/s), then n_record times with a
     Recorder; return (recorder, "") or, when a step stops at the work cap, (None, message).
-    The record window starts at the core's time after the transient."""
+    The record window starts at the core's time after the transient. With ``T_drive``
+    (N m) the core is a SpinCore driven by it (Omega then only scales the record)."""
     for _ in range(n_transient):
-        rep = core.step(h, Omega)
+        rep = (core.step(h, Omega) if T_drive is None
+               else core.step(h, T_drive=T_drive))  # type: ignore[call-arg]
         if rep.status != STATUS_OK:
             return None, f"transient: {rep.message}"
     rec = Recorder(core.params.c_r, Omega)
     t_rec0 = core.t
     for _ in range(n_record):
-        if rec.step(core, h, Omega, t_rec0) != STATUS_OK:
+        if rec.step(core, h, Omega, t_rec0, T_drive) != STATUS_OK:
             return None, "record window: step stopped at work cap"
     return rec, ""
 
@@ -109,9 +135,9 @@ def classify(n_impacts: int, slide_frac: float, roll_frac: float, period: int) -
     whip (rolling at least half the time), rub (in contact at least half the time),
     free (no impact, no contact), period-<n> (impact map n-periodic), else irregular.
     """
-    if roll_frac >= 0.5:
+    if roll_frac >= MOST:
         return "whip"
-    if slide_frac + roll_frac >= 0.5:
+    if slide_frac + roll_frac >= MOST:
         return "rub"
     if n_impacts == 0 and slide_frac + roll_frac == 0.0:
         return "free"
@@ -136,3 +162,118 @@ def chapter_regime(regime: str, n_impacts: int) -> str:
     if regime == "rub":
         return CHAPTER_REGIMES[2]
     return CHAPTER_REGIMES[1] if n_impacts > 0 else CHAPTER_REGIMES[0]
+
+
+# --------------------------------------------------------------------------- the drop
+
+
+@dataclass
+class DropRecorder:
+    """The drop's record window (SI): impacts, dwell times and step-end samples.
+
+    ``t_window`` (s) is the window's length; the sums are over the step-end samples of
+    the spin Omega (rad/s), the whirl rate theta' (rad/s) and the slip |v_rel| (m/s)."""
+
+    t_window: float
+    n_impacts: int = 0
+    t_slide: float = 0.0
+    t_roll: float = 0.0
+    n: int = 0
+    sum_Omega: float = 0.0
+    sum_whirl: float = 0.0
+    sum_slip: float = 0.0
+    r_max: float = -math.inf
+    r_min: float = math.inf
+
+    def step(self, core: TouchdownCore, h: float, Omega: float,
+             T_drive: float | None) -> int:
+        """Advance the core by h (s) with the bearing off and record; return the status."""
+        t0, mode = core.t, core.mode
+        rep = (core.step(h, Omega, amb_on=0.0) if T_drive is None
+               else core.step(h, amb_on=0.0, T_drive=T_drive))  # type: ignore[call-arg]
+        self.n_impacts += len(rep.impacts)
+        if rep.impacts:
+            self.r_max = max(self.r_max, 1.0)
+        t_prev = t0
+        for t_tr, kind in rep.transitions:
+            self._dwell(mode, t_tr - t_prev)
+            mode, t_prev = _MODE_OF[kind], t_tr
+        self._dwell(mode, core.t - t_prev)
+        k = core.kinematics(Omega if T_drive is None else None, 0.0)
+        W = Omega if T_drive is None else core.Omega  # type: ignore[attr-defined]
+        self.n += 1
+        self.sum_Omega += W
+        self.sum_whirl += k.whirl_rate
+        self.sum_slip += abs(k.v_rel)
+        self.r_max, self.r_min = max(self.r_max, k.r_rel), min(self.r_min, k.r_rel)
+        return rep.status
+
+    def _dwell(self, mode: int, dt: float) -> None:
+        if mode == MODE_SLIDING:
+            self.t_slide += dt
+        elif mode == MODE_ROLLING:
+            self.t_roll += dt
+
+    def summary(self, R: float, c_r: float) -> dict[str, float | int | str]:
+        """Fractions of the window, means (rad/s, m/s), slip ratio and the outcome."""
+        n = max(self.n, 1)
+        W, whirl, slip = self.sum_Omega / n, self.sum_whirl / n, self.sum_slip / n
+        slide, roll = self.t_slide / self.t_window, self.t_roll / self.t_window
+        scale = max(R * abs(W), c_r * abs(whirl))
+        ratio = slip / scale if scale > 0.0 else (0.0 if slip == 0.0 else math.inf)
+        return {
+            "n_impacts": self.n_impacts, "slide_frac": slide, "roll_frac": roll,
+            "contact_frac": slide + roll, "Omega_mean": W, "whirl_mean": whirl,
+            "slip_mean": slip, "slip_ratio": ratio,
+            "regime": classify_drop(self.n_impacts, slide, roll, W, whirl, ratio,
+                                    self.t_window),
+        }
+
+
+def run_drop(core: TouchdownCore, Omega: float, h: float, n_steps: int, n_window: int,
+             T_drive: float | None = None) -> tuple[DropRecorder | None, str]:
+    """Drop: step ``core`` n_steps times by h (s) with the bearing off (amb_on = 0) and
+    gravity as the core's parameters have it, recording the last n_window steps; Omega
+    (rad/s) is the held spin, or ignored with ``T_drive`` (N m, a SpinCore). Return
+    (recorder, "") or (None, message) when a step stops at the work cap."""
+    n_window = min(n_window, n_steps)
+    for i in range(n_steps - n_window):
+        rep = (core.step(h, Omega, amb_on=0.0) if T_drive is None
+               else core.step(h, amb_on=0.0, T_drive=T_drive))  # type: ignore[call-arg]
+        if rep.status != STATUS_OK:
+            return None, f"drop, step {i}: {rep.message}"
+    rec = DropRecorder(n_window * h)
+    for _ in range(n_window):
+        if rec.step(core, h, Omega, T_drive) != STATUS_OK:
+            return None, "drop record window: step stopped at work cap"
+    return rec, ""
+
+
+def classify_drop(n_impacts: int, slide_frac: float, roll_frac: float, Omega_mean: float,
+                  whirl_mean: float, slip_ratio: float, t_window: float) -> str:
+    """Outcome of a drop from its record window (docs/sweeps.md, tested in this order).
+
+    n_impacts: impacts in the window; slide_frac, roll_frac: fractions of the window
+    sliding and rolling; Omega_mean, whirl_mean: mean spin and whirl rate theta' (rad/s);
+    slip_ratio: mean |v_rel| over max(R |Omega_mean|, c_r |whirl_mean|); t_window (s).
+
+      no-contact      no impact and no contact in the window (``classify``'s free)
+      impacting       in contact less than half the window (``classify``: not rub/whip)
+      settled         in contact, but less than WHIRL_TURNS turns round the bearing:
+                      |whirl_mean| t_window < 2 pi WHIRL_TURNS (lying or rocking)
+      forward-rub     whirling with the spin: whirl_mean Omega_mean > 0 (Omega_mean >= 0
+                      counts as positive)
+      dry-whip        whirling against the spin, rolling: slip_ratio <= SLIP_ROLL
+      backward-whirl  whirling against the spin, sliding: slip_ratio > SLIP_ROLL
+    """
+    regime = classify(n_impacts, slide_frac, roll_frac, 0)
+    if regime == "free":
+        return "no-contact"
+    if regime not in ("rub", "whip"):
+        return "impacting"
+    if abs(whirl_mean) * t_window < 2.0 * math.pi * WHIRL_TURNS:
+        return "settled"
+    sense = 1.0 if Omega_mean >= 0.0 else -1.0
+    if sense * whirl_mean > 0.0:
+        return "forward-rub"
+    return "dry-whip" if slip_ratio <= SLIP_ROLL else "backward-whirl"

@@ -2,6 +2,7 @@
 
     rotortd plot RESULT.csv -o OUT.png [--c-r 0.7e-3]
     rotortd sweep gamma=0.05:0.3:1000 mu=0.15 --starts rest,steady,cycle,large --out S.parquet
+    rotortd sweep mu=0.02:0.5:12 J=3.2e-4:1.6:log12 --starts drop --out D.parquet
     rotortd sweep-plot S.parquet -o diagram.png
 
 RESULT.csv is an FMPy result file (``fmpy simulate ... --output-file RESULT.csv``).
@@ -107,7 +108,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     try:
         spec = parse_spec(args.spec, args.starts, args.seed)
         settings = Settings(args.transient, args.record, args.steps_per_rev, args.section,
-                            args.period_tol, args.max_period).validate()
+                            args.period_tol, args.max_period, args.drop_time,
+                            args.drop_window, args.drop_step).validate()
         if args.workers is not None and args.workers <= 0:
             raise SweepError(f"--workers {args.workers}: it must be > 0")
         if args.batch <= 0 or args.chunk <= 0:
@@ -145,12 +147,15 @@ def _add_sweep_parsers(sub: argparse._SubParsersAction) -> None:
     sw = sub.add_parser(
         "sweep", help="sweep one or two parameters on Dask, attractor signatures to Parquet",
         description="Sweep scaled parameters (gamma omega rho phi mu d R_over_cr) and/or "
-        "Omega (rad/s); others fixed at the chapter set. SPEC: name=a:b:n (grid), "
-        "name=a:b:~n (sorted random samples) or name=value (fixed).")
-    sw.add_argument("spec", nargs="+", help="name=a:b:n | name=a:b:~n | name=value")
+        "Omega (rad/s), J (kg m^2: the spin as a state) and T_drive (N m, needs J); others "
+        "fixed at the chapter set, the spin held when J is not given. SPEC: name=a:b:n "
+        "(grid), name=a:b:logn (geometric grid), name=a:b:~n (sorted random samples) or "
+        "name=value (fixed).")
+    sw.add_argument("spec", nargs="+",
+                    help="name=a:b:n | name=a:b:logn | name=a:b:~n | name=value")
     sw.add_argument("--starts", default="rest",
-                    help="comma list of rest, steady, large, cycle[:BRANCH], up[:SEED], "
-                    "down[:SEED] (default rest)")
+                    help="comma list of rest, steady, large, cycle[:BRANCH], drop, "
+                    "up[:SEED], down[:SEED] (default rest)")
     sw.add_argument("--out", type=Path, default=Path("sweep.parquet"),
                     help="output directory of Parquet part files (resumed if it exists)")
     sw.add_argument("--transient", type=float, default=300.0,
@@ -165,6 +170,12 @@ def _add_sweep_parsers(sub: argparse._SubParsersAction) -> None:
                     help="tolerance of the period-n test on impact points (default 1e-4)")
     sw.add_argument("--max-period", dest="max_period", type=int, default=32,
                     help="largest n tested for period-n (default 32)")
+    sw.add_argument("--drop-time", dest="drop_time", type=float, default=0.4,
+                    help="drop start: seconds with the bearing off (default 0.4)")
+    sw.add_argument("--drop-window", dest="drop_window", type=float, default=0.1,
+                    help="drop start: last seconds classified (default 0.1)")
+    sw.add_argument("--drop-step", dest="drop_step", type=float, default=1e-4,
+                    help="drop start: core step in seconds (default 1e-4)")
     sw.add_argument("--seed", type=int, default=0, help="seed of random samples (default 0)")
     sw.add_argument("--scheduler", default=None,
                     help="address of an existing Dask scheduler (tcp://host:8786)")

@@ -28,6 +28,7 @@ from rotortd import scaled
 from rotortd.scaled import regular_equilibrium
 
 from rotortd_tools.sweep import (
+    DROP_REGIMES,
     PARAM_NAMES,
     REGIMES,
     SweepError,
@@ -48,6 +49,17 @@ COLOURS = {
     "no-start": "0.85",
     "failed": "magenta",
 }
+DROP_COLOURS = {
+    "no-contact": "tab:green",
+    "impacting": "tab:blue",
+    "settled": "0.6",
+    "forward-rub": "tab:red",
+    "backward-whirl": "tab:orange",
+    "dry-whip": "black",
+    "no-start": "0.9",
+    "failed": "magenta",
+}
+"""Colours of the drop outcomes (``classify_drop``) in ``drop_map``."""
 EVENT_WORDS = {
     "fold": "fold",
     "period_doubling": "period doubling",
@@ -165,7 +177,11 @@ def plot_sweep(path: Path | str, out: Path | str, results: Path | None = DEFAULT
 
     matplotlib.use("Agg")
     cols, names, fixed = load(path)
-    if len(names) == 2:
+    meta = read_meta(path) or {}
+    if len(names) == 2 and set(cols["start"]) == {"drop"}:
+        logs = {a["name"]: bool(a.get("log")) for a in meta.get("axes", [])}
+        fig = drop_map(cols, names, fixed, logs)
+    elif len(names) == 2:
         fig = regime_map(cols, names, fixed)
     else:
         name = names[0] if names else "gamma"
@@ -309,6 +325,114 @@ def _draw_cells(ax, x: np.ndarray, y: np.ndarray, groups: np.ndarray) -> None:
                    s=_marker_size(x, y), marker="s", lw=0)
 
 
+def drop_map(cols: dict[str, np.ndarray], names: list[str], fixed: dict[str, float],
+             logs: dict[str, bool] | None = None):
+    """Three maps of a two-parameter drop sweep (``--starts drop``): the outcome
+    (``classify_drop``), the mean whirl rate over the window |theta'| / 2 pi (Hz; the whip
+    speed where the outcome is a backward whirl or dry whip), and the spin kept,
+    Omega_mean / Omega (the initial spin). With J an axis, the well-posedness bound
+    J = m mu e_c (R + e_c) (kg m^2) is drawn dashed when mu is the other axis."""
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap, LogNorm
+    from matplotlib.patches import Patch
+
+    logs = logs or {}
+    x, y = cols[names[0]].astype(float), cols[names[1]].astype(float)
+    xs, ys = np.unique(x), np.unique(y)
+    ix, iy = np.searchsorted(xs, x), np.searchsorted(ys, y)
+    ex = _edges_log(xs) if logs.get(names[0]) else _edges(xs)
+    ey = _edges_log(ys) if logs.get(names[1]) else _edges(ys)
+
+    def grid(values) -> np.ndarray:
+        Z = np.full((len(ys), len(xs)), np.nan)
+        Z[iy, ix] = values
+        return Z
+
+    regimes = [str(r) for r in cols["regime"]]
+    code = {g: k for k, g in enumerate(DROP_REGIMES)}
+    outcome = grid([code.get(r, code["failed"]) for r in regimes])
+    whirl = np.abs(cols["whirl_mean"].astype(float)) / (2.0 * np.pi)
+    whip = np.array([r in ("dry-whip", "backward-whirl") for r in regimes])
+    kept = cols["Omega_mean"].astype(float) / cols["Omega"].astype(float)
+    fig, axes = plt.subplots(1, 3, figsize=(17, 5.6), layout="constrained", sharey=True)
+    ax = axes[0]
+    ax.pcolormesh(ex, ey, outcome, vmin=-0.5, vmax=len(DROP_REGIMES) - 0.5,
+                  cmap=ListedColormap([DROP_COLOURS[g] for g in DROP_REGIMES]))
+    present = [g for g in DROP_REGIMES if g in set(regimes)]
+    ax.legend(handles=[Patch(color=DROP_COLOURS[g], label=g) for g in present],
+              loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, fontsize="small",
+              frameon=False)
+    ax.set_title("drop outcome (last window)", pad=34)
+    ax = axes[1]
+    Zw = grid(np.where(np.isfinite(whirl) & (whirl > 0), whirl, np.nan))
+    pos = Zw[np.isfinite(Zw)]
+    norm = LogNorm(max(float(pos.min()), 1e-3), float(pos.max())) if pos.size else None
+    m = ax.pcolormesh(ex, ey, Zw, cmap="viridis", norm=norm)
+    fig.colorbar(m, ax=ax, label="|mean whirl rate| / 2π [Hz]")
+    Zm = grid(np.where(whip, 1.0, 0.0))
+    ax.contour(xs, ys, Zm, levels=[0.5], colors="w", linewidths=1.5)
+    if np.isfinite(Zw).sum() > 3:
+        cs = ax.contour(xs, ys, Zw, levels=[30, 100, 300, 1000], colors="w",
+                        linewidths=0.6, linestyles=":")
+        ax.clabel(cs, fmt="%g Hz", fontsize=7)
+    ax.set_title("whirl speed (white line: backward whirl / dry whip inside)")
+    ax = axes[2]
+    m = ax.pcolormesh(ex, ey, grid(kept), cmap="magma", vmin=min(0.0, np.nanmin(kept)),
+                      vmax=1.0)
+    fig.colorbar(m, ax=ax, label="mean Ω over the window / initial Ω")
+    cs = ax.contour(xs, ys, grid(kept), levels=[0.1, 0.25, 0.5, 0.75, 0.9], colors="w",
+                    linewidths=0.6)
+    ax.clabel(cs, fmt="%g", fontsize=7)
+    ax.set_title("spin kept")
+    for ax in axes:
+        _drop_axes(ax, names, logs, xs, fixed)
+    fig.suptitle(f"drop with the spin as a state: {len(x)} points; fixed: "
+                 f"{_fixed_text(fixed)}")
+    return fig
+
+
+def _drop_axes(ax, names: list[str], logs: dict[str, bool], xs: np.ndarray,
+               fixed: dict[str, float]) -> None:
+    from matplotlib.ticker import FormatStrFormatter, NullFormatter
+
+    ax.set_xscale("log" if logs.get(names[0]) else "linear")
+    ax.set_yscale("log" if logs.get(names[1]) else "linear")
+    for axis, name in ((ax.xaxis, names[0]), (ax.yaxis, names[1])):
+        if logs.get(name):
+            axis.set_minor_formatter(NullFormatter())
+            if name == "mu":
+                axis.set_ticks([0.02, 0.05, 0.1, 0.2, 0.5])
+                axis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.set_xlabel(_label(names[0]))
+    ax.set_ylabel(_label(names[1]))
+    if names == ["mu", "J"]:
+        bound = [_j_bound({**fixed, "mu": float(v)}) for v in xs]
+        lo, hi = ax.get_ylim()
+        ax.plot(xs, bound, "w--", lw=1)
+        mR2 = _m_R2(fixed)
+        for frac, text in ((0.5, "½ m R² (solid disc)"), (1.0, "m R²")):
+            ax.axhline(frac * mR2, color="c", ls=":", lw=0.8)
+            ax.text(xs[0], frac * mR2, text, color="c", fontsize=7, va="bottom")
+        ax.set_ylim(lo, hi)
+
+
+def _j_bound(values: dict[str, float]) -> float:
+    """Well-posedness bound m mu e_c (R + e_c) (kg m^2) at a point."""
+    p = point_params(values)[0]
+    return p.m * p.mu * p.e_c * (p.R + p.e_c)
+
+
+def _m_R2(values: dict[str, float]) -> float:
+    """m R^2 (kg m^2) at a point."""
+    p = point_params(values)[0]
+    return p.m * p.R * p.R
+
+
+def _edges_log(v: np.ndarray) -> np.ndarray:
+    """Cell edges around sorted positive centres v, geometric midpoints."""
+    return np.exp(_edges(np.log(v)))
+
+
 def _edges(v: np.ndarray) -> np.ndarray:
     """Cell edges around sorted centres v."""
     mid = (v[1:] + v[:-1]) / 2.0
@@ -338,7 +462,8 @@ def _beb_curve(names, x, y, fixed, n: int = 120):
 def _label(name: str) -> str:
     return {"gamma": "γ = c/(mΩ)", "omega": "ω = √(k/m)/Ω", "rho": "ρ = e_c/c_r",
             "phi": "φ [rad]", "mu": "μ", "d": "d (restitution)", "R_over_cr": "R/c_r",
-            "Omega": "Ω [rad/s]"}.get(name, name)
+            "Omega": "Ω [rad/s]", "J": "J [kg m²]",
+            "T_drive": "T_drive [N m]"}.get(name, name)
 
 
 def _fixed_text(fixed: dict[str, float]) -> str:

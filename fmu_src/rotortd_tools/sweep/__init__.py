@@ -3,8 +3,10 @@
 ``rotortd sweep`` (docs/sweeps.md). The modules, by job:
 
   spec       the grammar: parameter names, ranges, axes, settings, start labels, and what a
-             point is (``point_params``: the chapter's set with the named fields replaced)
-  starts     the initial state of a run (rest, steady, large, cycle[:BRANCH], continuation)
+             point is (``point_params``: the chapter's set with the named fields replaced;
+             ``spin_inputs``: J and T_drive, the spin as a state)
+  starts     the initial state of a run (rest, steady, large, cycle[:BRANCH], drop,
+             continuation), in a SpinCore when J is given
   signature  run to the attractor (``rotortd_tools.attractor``) and summarise it as a row
   schema     the output columns and their types
   jobs       one run (point, start) as a row, alone or chained from a previous state
@@ -18,7 +20,16 @@ in c_r Omega, angles in rad, co-rotating (U = z e^{-i psi}/c_r). The names below
 package's interface (tests, ``rotortd_tools.cli``, ``sweep_plot``, docs/scripts).
 """
 
-from rotortd_tools.attractor import Recorder, classify, detect_period, regime_group
+from rotortd_tools.attractor import (
+    DROP_OUTCOMES,
+    DropRecorder,
+    Recorder,
+    classify,
+    classify_drop,
+    detect_period,
+    regime_group,
+    run_drop,
+)
 from rotortd_tools.sweep.execute import (
     dask_client,
     run_dask,
@@ -28,16 +39,18 @@ from rotortd_tools.sweep.execute import (
 )
 from rotortd_tools.sweep.jobs import Job, base_row, point_key, run_batch, run_job, run_segment
 from rotortd_tools.sweep.plan import Plan, all_jobs, batches, chains_of, make_plan
-from rotortd_tools.sweep.schema import COLUMNS, REGIMES, arrow_schema
-from rotortd_tools.sweep.signature import signature, simulate
+from rotortd_tools.sweep.schema import COLUMNS, DROP_REGIMES, REGIMES, arrow_schema
+from rotortd_tools.sweep.signature import signature, simulate, simulate_drop
 from rotortd_tools.sweep.spec import (
     ALIASES,
     CONTINUATION,
     CYCLE_BRANCHES,
+    DROP_G,
     PARAM_NAMES,
     RANGES,
     SCALED_NAMES,
     SIMPLE_STARTS,
+    SPIN_NAMES,
     Axis,
     Settings,
     SweepError,
@@ -45,10 +58,12 @@ from rotortd_tools.sweep.spec import (
     canonical_name,
     check_value,
     cycle_finder,
+    drop_params,
     parse_axis,
     parse_spec,
     parse_starts,
     point_params,
+    spin_inputs,
 )
 from rotortd_tools.sweep.starts import NoStart, core_for, make_start
 from rotortd_tools.sweep.store import (
@@ -63,13 +78,15 @@ from rotortd_tools.sweep.store import (
 )
 
 __all__ = [
-    "ALIASES", "COLUMNS", "CONTINUATION", "CYCLE_BRANCHES", "FORMAT_VERSION", "META_FILE",
-    "PARAM_NAMES", "RANGES", "REGIMES", "SCALED_NAMES", "SIMPLE_STARTS", "Axis", "Job",
+    "ALIASES", "COLUMNS", "CONTINUATION", "CYCLE_BRANCHES", "DROP_G", "DROP_OUTCOMES",
+    "DROP_REGIMES", "FORMAT_VERSION", "META_FILE", "PARAM_NAMES", "RANGES", "REGIMES",
+    "SCALED_NAMES", "SIMPLE_STARTS", "SPIN_NAMES", "Axis", "DropRecorder", "Job",
     "NoStart", "ParquetSink", "Plan", "Recorder", "Settings", "SweepError", "SweepSpec",
     "all_jobs", "arrow_schema", "base_row", "batches", "canonical_name", "chains_of",
-    "check_value", "classify", "core_for", "cycle_finder", "dask_client", "detect_period",
-    "make_plan", "make_start", "parse_axis", "parse_spec", "parse_starts", "part_files",
-    "point_key", "point_params", "prepare_output", "read_meta", "read_sweep", "regime_group",
-    "run_batch", "run_dask", "run_job", "run_segment", "run_serial", "run_sweep", "signature",
-    "simulate", "spec_meta", "submit_plan",
+    "check_value", "classify", "classify_drop", "core_for", "cycle_finder", "dask_client",
+    "detect_period", "drop_params", "make_plan", "make_start", "parse_axis", "parse_spec",
+    "parse_starts", "part_files", "point_key", "point_params", "prepare_output",
+    "read_meta", "read_sweep", "regime_group", "run_batch", "run_dask", "run_drop",
+    "run_job", "run_segment", "run_serial", "run_sweep", "signature", "simulate",
+    "simulate_drop", "spec_meta", "spin_inputs", "submit_plan",
 ]

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from rotortd_tools.sweep.schema import empty_signature
-from rotortd_tools.sweep.signature import simulate
-from rotortd_tools.sweep.spec import SCALED_NAMES, Settings, point_params
+from rotortd_tools.sweep.signature import simulate, simulate_drop
+from rotortd_tools.sweep.spec import SCALED_NAMES, Settings, point_params, spin_inputs
 from rotortd_tools.sweep.starts import NoStart, core_for
 
 
@@ -40,19 +41,26 @@ def base_row(job: Job, settings: Settings) -> dict[str, Any]:
     row: dict[str, Any] = {"key": job.key, "index": job.index, "start": job.start}
     row.update({k: float(getattr(sp, k)) for k in SCALED_NAMES})
     row["Omega"] = Omega
+    J, T_drive = spin_inputs(dict(job.values))
+    row["J"] = math.nan if J is None else J
+    row["T_drive"] = math.nan if J is None else T_drive
     row.update({"transient": settings.transient, "record": settings.record})
     return row
 
 
 def run_job(job: Job, settings: Settings, state: dict | None = None
             ) -> tuple[dict[str, Any], dict | None]:
-    """Run one job (from ``state`` if given, else its start); return (row, final state)."""
+    """Run one job (from ``state`` if given, else its start); return (row, final state).
+    With J the core is a SpinCore driven by T_drive; the ``drop`` start runs the drop."""
     row = base_row(job, settings)
     t0 = time.process_time()
     p, Omega, sp = point_params(dict(job.values))
+    J, T_drive = spin_inputs(dict(job.values))
+    T = None if J is None else T_drive
     try:
-        core = core_for(job.start, p, Omega, sp, state)
-        sig = simulate(core, Omega, settings)
+        core = core_for(job.start, p, Omega, sp, state, J)
+        run = simulate_drop if job.start == "drop" else simulate
+        sig = run(core, Omega, settings, T)
         final = core.get_state() if sig["status"] == "ok" else None
     except NoStart as exc:
         sig, final = {"status": "no-start", "message": str(exc)}, None

@@ -1,12 +1,15 @@
 """The sweep grammar: parameter names and ranges, axes, settings, starts, and what a point is.
 
 Parameters are the chapter's scaled set (MODEL.md §2: gamma, omega, rho, phi, mu, d,
-R_over_cr) plus the spin speed ``Omega`` in rad/s. A point starts from the chapter's SI set
-(MODEL.md §3) at ``Omega`` (default 184.2 rad/s), takes its scaled set and replaces the
-fields the sweep names (swept or fixed); it is realised in SI with m = 50 kg, c_r = 0.7e-3 m,
-no gravity, bearing on (``point_params``). Sweeping ``Omega`` alone therefore keeps the SI
+R_over_cr) plus the spin speed ``Omega`` in rad/s, and the spin-state inputs ``J`` (polar
+inertia about the mass centre, kg m^2: the run uses ``rotortd.SpinCore``, Omega is then only
+the initial spin) and ``T_drive`` (held drive torque, N m; needs J). A point starts from
+the chapter's SI set (MODEL.md §3) at ``Omega`` (default 184.2 rad/s), takes its scaled set
+and replaces the fields the sweep names (swept or fixed); it is realised in SI with
+m = 50 kg, c_r = 0.7e-3 m, no gravity, bearing on (``point_params``); the ``drop`` start
+adds gravity ``DROP_G`` (``drop_params``). Sweeping ``Omega`` alone therefore keeps the SI
 set, so gamma and omega vary as 1/Omega. Times in ``Settings`` are scaled, t = Omega tau
-(one revolution is 2 pi).
+(one revolution is 2 pi), except the drop's, which are in seconds.
 """
 
 from __future__ import annotations
@@ -14,15 +17,18 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from rotortd import ParameterError, RotorParams, ScaledParams
+from rotortd.rigid import check_well_posed
 from rotortd.scaled import CHAPTER_OMEGA, chapter_params, si_params
 
 SCALED_NAMES = ("gamma", "omega", "rho", "phi", "mu", "d", "R_over_cr")
-PARAM_NAMES = (*SCALED_NAMES, "Omega")
+SPIN_NAMES = ("J", "T_drive")
+"""The spin-state inputs: J (kg m^2, selects ``SpinCore``) and T_drive (N m, needs J)."""
+PARAM_NAMES = (*SCALED_NAMES, "Omega", *SPIN_NAMES)
 ALIASES = {"R/c_r": "R_over_cr", "R/cr": "R_over_cr", "Rcr": "R_over_cr", "W": "Omega"}
 RANGES: dict[str, tuple[float | None, float | None, bool]] = {
     "gamma": (0.0, None, False),
@@ -33,9 +39,13 @@ RANGES: dict[str, tuple[float | None, float | None, bool]] = {
     "d": (0.0, 1.0, False),
     "R_over_cr": (0.0, None, True),
     "Omega": (0.0, None, True),
+    "J": (0.0, None, True),
+    "T_drive": (None, None, False),
 }
 """(lo, hi, lo_open) of each parameter; None means unbounded."""
-SIMPLE_STARTS = ("rest", "steady", "large", "cycle")
+SIMPLE_STARTS = ("rest", "steady", "large", "cycle", "drop")
+DROP_G = 9.81
+"""Gravity of the ``drop`` start (m/s^2, downward -y): the bearing fails under it."""
 CONTINUATION = ("up", "down")
 CYCLE_BRANCHES = ("short-small", "short-large", "long-small", "long-large")
 
@@ -55,11 +65,18 @@ class Axis:
     n: int
     random: bool
     values: tuple[float, ...]
+    log: bool = False
 
 
 @dataclass(frozen=True)
 class Settings:
-    """How each run is made and summarised (scaled times, t = Omega tau)."""
+    """How each run is made and summarised.
+
+    transient, record: scaled times (t = Omega tau); steps_per_rev, section, period_tol,
+    max_period: see docs/sweeps.md. The ``drop`` start instead runs drop_time seconds at
+    steps of drop_step seconds with the bearing off, and classifies the last drop_window
+    seconds (``rotortd_tools.attractor.classify_drop``).
+    """
 
     transient: float = 300.0
     record: float = 100.0
@@ -67,6 +84,9 @@ class Settings:
     section: int = 64
     period_tol: float = 1e-4
     max_period: int = 32
+    drop_time: float = 0.4
+    drop_window: float = 0.1
+    drop_step: float = 1e-4
 
     def validate(self) -> Settings:
         """Raise SweepError naming a bad setting; return self."""
@@ -77,6 +97,11 @@ class Settings:
             ("section", self.section >= 0, ">= 0"),
             ("period_tol", self.period_tol > 0.0, "> 0"),
             ("max_period", self.max_period >= 1, ">= 1"),
+            ("drop_time", self.drop_time > 0.0 and math.isfinite(self.drop_time), "> 0"),
+            ("drop_window", 0.0 < self.drop_window <= self.drop_time,
+             "in (0, drop_time]"),
+            ("drop_step", 0.0 < self.drop_step <= self.drop_window,
+             "in (0, drop_window]"),
         )
         for name, ok, rule in checks:
             if not ok:
@@ -146,14 +171,17 @@ def _number(name: str, text: str) -> float:
 
 
 def parse_axis(name: str, text: str, seed: int, index: int) -> Axis:
-    """Parse ``a:b:n`` (grid, both ends included) or ``a:b:~n`` (sorted uniform samples)."""
+    """Parse ``a:b:n`` (grid, both ends included), ``a:b:logn`` (geometric grid, both ends
+    included, a > 0) or ``a:b:~n`` (sorted uniform samples)."""
     parts = text.split(":")
     if len(parts) != 3:
-        raise SweepError(f"{name}: bad range {text!r}: write a:b:n (grid) or a:b:~n (random)")
+        raise SweepError(f"{name}: bad range {text!r}: write a:b:n (grid), a:b:logn "
+                         "(geometric grid) or a:b:~n (random)")
     lo, hi = _number(name, parts[0]), _number(name, parts[1])
     n_text = parts[2].strip()
     random = n_text.startswith("~")
-    n_text = n_text[1:] if random else n_text
+    log = n_text.startswith("log")
+    n_text = n_text[1:] if random else n_text[3:] if log else n_text
     try:
         n = int(n_text)
     except ValueError:
@@ -164,12 +192,17 @@ def parse_axis(name: str, text: str, seed: int, index: int) -> Axis:
     check_value(name, hi, "upper end")
     if not lo < hi and not (n == 1 and lo == hi):
         raise SweepError(f"{name}: bad range {text!r}: the lower end must be below the upper")
+    if log and not lo > 0.0:
+        raise SweepError(f"{name}: geometric grid {text!r} needs a lower end > 0")
     if random:
         rng = np.random.default_rng([seed, index])
         vals = np.sort(rng.uniform(lo, hi, n))
+    elif log:
+        vals = np.geomspace(lo, hi, n)
+        vals[0], vals[-1] = lo, hi
     else:
         vals = np.linspace(lo, hi, n)
-    return Axis(name, lo, hi, n, random, tuple(float(v) for v in vals))
+    return Axis(name, lo, hi, n, random, tuple(float(v) for v in vals), log)
 
 
 def parse_starts(text: str | Sequence[str]) -> tuple[str, ...]:
@@ -196,6 +229,8 @@ def _check_start(label: str) -> None:
             _check_start(tail)
             if tail.partition(":")[0] in CONTINUATION:
                 raise SweepError(f"start {label!r}: a continuation seed cannot be up/down")
+            if tail == "drop":
+                raise SweepError(f"start {label!r}: a drop cannot seed a continuation")
         return
     if head == "cycle":
         if tail and tail not in CYCLE_BRANCHES:
@@ -207,7 +242,7 @@ def _check_start(label: str) -> None:
     if head in SIMPLE_STARTS and not tail:
         return
     raise SweepError(
-        f"unknown start {label!r}: choose from rest, steady, large, cycle[:BRANCH], "
+        f"unknown start {label!r}: choose from rest, steady, large, cycle[:BRANCH], drop, "
         "up[:SEED], down[:SEED]"
     )
 
@@ -233,6 +268,9 @@ def parse_spec(tokens: Sequence[str], starts: str | Sequence[str] = "rest",
     if len(axes) > 2:
         raise SweepError(f"at most two parameters can be swept, got {len(axes)}: "
                          f"{', '.join(a.name for a in axes)}")
+    if "T_drive" in seen and "J" not in seen:
+        raise SweepError("T_drive needs J: with the spin held (no J) a drive torque has no "
+                         "effect; give J=... to make the spin a state")
     spec = SweepSpec(tuple(axes), tuple(sorted(fixed.items())), parse_starts(starts), seed)
     _check_realisable(spec)
     _check_cycle_available(spec.starts)
@@ -240,12 +278,17 @@ def parse_spec(tokens: Sequence[str], starts: str | Sequence[str] = "rest",
 
 
 def _check_realisable(spec: SweepSpec) -> None:
-    """Build the SI set at the corners of the sweep so a bad combination fails early."""
+    """Build the SI set at the corners of the sweep so a bad combination fails early; with
+    J, check that contact is well posed there (J > m mu e_c (R + e_c), monotone in each
+    parameter, so the corners decide)."""
     corners = [(a.values[0], a.values[-1]) for a in spec.axes]
     for combo in itertools.product(*corners):
         values = spec.values_of(dict(zip(spec.names, combo)))
         try:
-            point_params(values)
+            p = point_params(values)[0]
+            J = spin_inputs(values)[0]
+            if J is not None:
+                check_well_posed(p, J)
         except ParameterError as exc:
             raise SweepError(f"parameters {values} cannot be realised: {exc}") from None
 
@@ -274,3 +317,14 @@ def point_params(values: dict[str, float]) -> tuple[RotorParams, float, ScaledPa
     Omega = float(values.get("Omega", CHAPTER_OMEGA))
     sp = chapter_params(Omega, **{k: float(v) for k, v in values.items() if k in SCALED_NAMES})
     return si_params(sp, Omega), Omega, sp
+
+
+def spin_inputs(values: dict[str, float]) -> tuple[float | None, float]:
+    """(J in kg m^2 or None for the held spin, T_drive in N m) of a point."""
+    J = values.get("J")
+    return (None if J is None else float(J)), float(values.get("T_drive", 0.0))
+
+
+def drop_params(p: RotorParams) -> RotorParams:
+    """The point's SI set with gravity DROP_G (m/s^2), for the ``drop`` start."""
+    return replace(p, g=DROP_G)

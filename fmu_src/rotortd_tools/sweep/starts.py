@@ -8,28 +8,57 @@ for the core:
   large           U = 0.9 U*/|U*|, inertial velocity 0 (released near the wall, no whirl)
   cycle[:BRANCH]  right after the impact of the period-one impacting cycle found by Newton
                   on the impact map (``rotortd_tools.cycles.find_period_one_cycle``)
+  drop            on the levitated steady whirl (held speed, bearing on) with gravity
+                  DROP_G; the run then turns the bearing off (``run_drop``)
   up[:SEED], down[:SEED]
                   continuation along the first swept parameter: each point starts from the
                   previous point's final state (``get_state``/``set_state``, exact); the
                   first point of a pass (and any point after a failed one) starts from SEED
                   (rest by default). One chain per value of the second parameter.
+
+With J (kg m^2) every start is the same state in a ``SpinCore`` of that inertia, spinning
+at Omega (rad/s); a continued state takes the point's J.
 """
 
 from __future__ import annotations
 
-from rotortd import ParameterError, RotorParams, ScaledParams, TouchdownCore
-from rotortd.scaled import regular_equilibrium
+from dataclasses import replace
 
-from rotortd_tools.sweep.spec import CONTINUATION, SCALED_NAMES, SweepError, cycle_finder
+from rotortd import ParameterError, RotorParams, ScaledParams, SpinCore, TouchdownCore
+from rotortd.scaled import regular_equilibrium
+from rotortd.state import CoreState
+
+from rotortd_tools.sweep.spec import (
+    CONTINUATION,
+    SCALED_NAMES,
+    SweepError,
+    cycle_finder,
+    drop_params,
+)
 
 
 class NoStart(RuntimeError):
     """A start does not exist at this point (inadmissible whirl, no cycle)."""
 
 
-def make_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams) -> TouchdownCore:
-    """A core at the named simple start (rest, steady, large, cycle[:BRANCH])."""
+def make_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams,
+               J: float | None = None) -> TouchdownCore:
+    """A core at the named simple start (rest, steady, large, cycle[:BRANCH], drop); with
+    J (kg m^2) the same state in a SpinCore spinning at Omega (rad/s)."""
+    core = _held_start(label, p, Omega, sp)
+    if J is None:
+        return core
+    return SpinCore(core.params, J, core.z, core.v, core.psi, Omega, core.t)
+
+
+def _held_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams
+                ) -> TouchdownCore:
     head, _, branch = label.partition(":")
+    if head == "drop":
+        try:
+            return TouchdownCore.on_steady_whirl(drop_params(p), Omega)
+        except ParameterError as exc:
+            raise NoStart(str(exc)) from None
     if head == "rest":
         return TouchdownCore(p)
     U_star = regular_equilibrium(sp)
@@ -59,16 +88,21 @@ def _cycle_start(p: RotorParams, Omega: float, sp: ScaledParams, branch: str) ->
 
 
 def core_for(start: str, p: RotorParams, Omega: float, sp: ScaledParams,
-              state: dict | None) -> TouchdownCore:
-    """A core at the start, or continued from ``state`` with the point's parameters."""
+             state: dict | None, J: float | None = None) -> TouchdownCore:
+    """A core at the start, or continued from ``state`` with the point's parameters (and
+    its J, kg m^2, when given: a SpinCore)."""
     head, _, seed = start.partition(":")
     if head in CONTINUATION:
         if state is None:
-            return make_start(seed or "rest", p, Omega, sp)
-        core = TouchdownCore(p)
-        core.set_state(state)
+            return make_start(seed or "rest", p, Omega, sp, J)
+        if J is None:
+            core = TouchdownCore(p)
+            core.set_state(state)
+        else:
+            core = SpinCore(p, J)
+            core.set_state(replace(CoreState.from_json(state), J=J))
         core.set_params(p)
         return core
-    return make_start(start, p, Omega, sp)
+    return make_start(start, p, Omega, sp, J)
 
 

@@ -15,7 +15,10 @@ from rotortd_tools.sweep.schema import arrow_schema
 from rotortd_tools.sweep.spec import Settings, SweepError, SweepSpec
 
 META_FILE = "_sweep.json"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+"""Store format: 2 added the columns J, T_drive, Omega_end, Omega_mean, whirl_mean,
+slip_mean, slip_ratio and the drop settings. A format-1 store is still read (``read_sweep``,
+``rotortd sweep-plot``) but is not resumed."""
 
 
 class ParquetSink:
@@ -81,7 +84,7 @@ def read_sweep(path: Path | str, columns: Sequence[str] | None = None) -> dict[s
     if not files:
         return {}
     tables = [pq.read_table(f, columns=list(columns) if columns else None) for f in files]
-    return pa.concat_tables(tables).to_pydict()
+    return pa.concat_tables(tables, promote_options="default").to_pydict()
 
 
 def read_meta(path: Path | str) -> dict[str, Any] | None:
@@ -94,8 +97,8 @@ def spec_meta(spec: SweepSpec, settings: Settings) -> dict[str, Any]:
     """JSON description of a sweep: what a resume must match."""
     return {
         "format": FORMAT_VERSION,
-        "axes": [{"name": a.name, "lo": a.lo, "hi": a.hi, "n": a.n, "random": a.random}
-                 for a in spec.axes],
+        "axes": [{"name": a.name, "lo": a.lo, "hi": a.hi, "n": a.n, "random": a.random,
+                  "log": a.log} for a in spec.axes],
         "fixed": dict(spec.fixed),
         "seed": spec.seed,
         "settings": asdict(settings),
@@ -113,6 +116,13 @@ def prepare_output(path: Path, spec: SweepSpec, settings: Settings, overwrite: b
             f.unlink(missing_ok=True)
     new = spec_meta(spec, settings)
     old = read_meta(path)
+    if old is not None and old.get("format") != FORMAT_VERSION:
+        raise SweepError(
+            f"output {path} holds a sweep in store format {old.get('format')!r}, this is "
+            f"format {FORMAT_VERSION} (columns J, T_drive, Omega_end, Omega_mean, "
+            "whirl_mean, slip_mean, slip_ratio were added): it can still be read "
+            "(read_sweep, sweep-plot) but not resumed; use --overwrite or another --out"
+        )
     if old is not None:
         same = {k: v for k, v in old.items() if k != "starts"}
         if same != {k: v for k, v in new.items() if k != "starts"}:
