@@ -201,13 +201,32 @@ INTEGRATED = [
 def test_integrated_vs_mp_taylor(c: float, g: float, T: float, Om: float) -> None:
     p = _bearing(c=c, g=g)
     sc = Scene(p, J0, 1.0, 30.0 - 20.0j, T, 1e-4 - 5e-5j, 0.01 + 0.005j, 0.7, Om)
-    t_end = 0.05
+    t_end = 0.1 if Om == 60.0 else 0.02  # the fast scenes reach the wall at ~25 ms
     e = sc.flight().run(t_end, BIG)
     ref = MpTaylor(sc, t_end)
     w = max(abs(Om), abs(e.Omega), math.sqrt(p.k / p.m))
     err = _close(sc.flight(), ref.at(e.duration), e, p.c_r * w, w)
     assert max(err) <= 1e-12, (e, err)
     assert err[0] <= 1e-13, err  # stated: well below the bound in position
+
+
+def test_integrated_contact_time_and_state() -> None:
+    p = _bearing(c=1400.0, g=9.81)
+    sc = Scene(p, J0, 1.0, 0j, 50.0, 2e-4 + 1e-4j, 0.05 - 0.02j, 0.4, 184.2)
+    e = sc.flight().run(0.1, BIG)
+    assert e.event == "contact"
+    ref = MpTaylor(sc, e.duration * 1.001)
+    cr = mp.mpf(p.c_r)
+    t = mp.findroot(lambda t: abs(ref.at(t)[0]) - cr, mp.mpf(e.duration))
+    z, v, _, Om = ref.at(t)
+    rdot = float((mp.conj(z) * v).real / cr)
+    assert rdot > 0.01
+    # conditioning of the time: a few eps c_r / rdot, plus the method's error (1e-15 c_r)
+    assert abs(e.duration - t) <= 8e-16 * float(t) + 4e-15 * p.c_r / rdot
+    assert abs(abs(e.z) - p.c_r) <= 2e-16 * p.c_r
+    assert float(abs(mp.mpc(e.z) - z)) <= 1e-14 * p.c_r
+    assert float(abs(mp.mpc(e.v) - v)) <= 1e-14 * float(abs(v))
+    assert abs(e.Omega - Om) <= 1e-14 * Om
 
 
 # ------------------------------------------------------------------ grazing
@@ -294,22 +313,26 @@ def test_grazing(name: str, excess: float) -> None:
 
 
 # ------------------------------------------------------------------ degenerate cases
-def test_start_on_wall_inward_and_outward() -> None:
-    sc = drop_scene(T=0.0, g=9.81)
-    p = sc.p
+@pytest.mark.parametrize("a", [0.0, 1.0])
+def test_start_on_wall_inward_and_outward(a: float) -> None:
+    p = RotorParams(g=9.81, levitate=False)
+    F = 0j if a == 0.0 else -2000j  # bearing on: push down harder than the spring pulls up
     z = p.c_r * cmath.exp(-0.6j)
     n = z / abs(z)
-    # inward: no contact at duration 0
-    e = SpinFlight(p, J0, 0.0, 0j, 0.0, z, -0.05 * n + 0.01j * n, 0.2, 184.2).run(1e-3, BIG)
-    assert e.duration > 0.0
-    # rdot = 0, acceleration outward (gravity at the bottom, spin at rest): contact at 0
+    # inward: no contact at duration 0, the flight goes on for a while
+    e = SpinFlight(p, J0, a, F, 0.0, z, -0.05 * n + 0.01j * n, 0.2, 184.2).run(1e-3, BIG)
+    assert e.duration > 1e-4
+    # rdot = 0, acceleration outward (pushed down at the bottom, spin at rest): contact at 0
     zb = -1j * p.c_r
-    e = SpinFlight(p.replace(e_c=0.0), J0, 0.0, 0j, 0.0, zb, 0.01 + 0j, 0.0, 0.0).run(1e-3, BIG)
+    q = p.replace(e_c=0.0)
+    e = SpinFlight(q, J0, a, F, 0.0, zb, 0.01 + 0j, 0.0, 0.0).run(1e-3, BIG)
     assert e.event == "contact" and e.duration == 0.0
     # rdot = 0 at the top: the motion curves inward, a flight follows
-    e = SpinFlight(p.replace(e_c=0.0), J0, 0.0, 0j, 0.0, 1j * p.c_r, 0.01 + 0j, 0.0, 0.0
-                   ).run(1e-3, BIG)
-    assert e.duration > 0.0
+    e = SpinFlight(q, J0, a, F, 0.0, 1j * p.c_r, 0.01 + 0j, 0.0, 0.0).run(1e-3, BIG)
+    assert e.duration > 1e-4
+    # on the wall moving outward: an impact at 0
+    e = SpinFlight(p, J0, a, F, 0.0, z, 0.05 * n, 0.2, 184.2).run(1e-3, BIG)
+    assert e.event == "contact" and e.duration == 0.0 and e.z == z
 
 
 @pytest.mark.parametrize("kw", [

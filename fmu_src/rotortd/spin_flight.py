@@ -374,12 +374,8 @@ class SpinFlight:
             az, av = abs(z), abs(v)
             M1 = 2.0 * az * av * ic2
             M2 = 2.0 * (av * av + az * abs(acc)) * ic2
-            # the integrated state's point error, in every coefficient
-            g0 += 3.0 * rho
-            g1 += 3.0 * rho * M1
-            g2 += 3.0 * rho * M2
-            if g0 >= -TOL_G:
-                kind = self._at_wall(g0, g1, g2, g3, M1, M2)
+            if g0 + 3.0 * rho >= -TOL_G:  # at the wall to resolution and the point error
+                kind = self._at_wall(g0, g1, g2, g3, M1, M2, 3.0 * rho)
                 if kind == "impact":
                     if s == 0.0:
                         return self._end(0.0, z, v, dpsi, Om, "contact", work)
@@ -392,7 +388,12 @@ class SpinFlight:
                     s = min(rem, s + self._grace(v, Om, g3, work))
                     z, v, dpsi, Om, E = self.state(s, work)
                     continue
-                g0, g1 = 0.0, min(g1, 0.0)  # leaving the wall
+                # leaving the wall (G' < -its band, which holds the point error)
+                g0, g1, g2 = 0.0, g1 + 3.0 * rho * M1, g2 + 3.0 * rho * M2
+            else:  # the point error, in every coefficient of the bound
+                g0 += 3.0 * rho
+                g1 += 3.0 * rho * M1
+                g2 += 3.0 * rho * M2
             remaining = rem - s
             if remaining <= 0.0:
                 return self._end(rem, z, v, dpsi, Om, None, work)
@@ -489,10 +490,13 @@ class SpinFlight:
             v = wG0 - ig * s - 1j * Om * ecE
 
     @staticmethod
-    def _at_wall(g0: float, g1: float, g2: float, g3: float, M1: float, M2: float) -> str:
-        """Classify a point with G >= -TOL_G: "impact", "touch", "leave" or "graze"."""
-        tol1 = 16.0 * EPS * M1 + 1e-300
-        tol2 = 64.0 * EPS * M2 + 1e-300
+    def _at_wall(g0: float, g1: float, g2: float, g3: float, M1: float, M2: float,
+                 err: float = 0.0) -> str:
+        """Classify a point at the wall: "impact", "touch", "leave" or "graze". g0..g3: G and
+        its derivatives; M1, M2: the sizes of the terms of G' and G''; err: the relative
+        point error of the state (integrated case), which widens the bands of G' and G''."""
+        tol1 = (16.0 * EPS + err) * M1 + 1e-300
+        tol2 = (64.0 * EPS + err) * M2 + 1e-300
         if g1 > tol1 and (g2 >= 0.0 or g0 + g1 * g1 / (-2.0 * g2) > TOL_G):
             return "impact"  # outward, with an excursion beyond the wall above resolution
         if g1 < -tol1:
