@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import cmath
 import math
+import random
 from dataclasses import dataclass
 
 import mpmath as mp
@@ -369,3 +370,34 @@ def test_work_bound_and_determinism() -> None:
     assert cl.flight().run(0.1, BIG).work == cl.flight().run(0.1, BIG).work
     with pytest.raises(ContactWorkExceeded):
         drop_scene(g=0.0).flight(p=RotorParams(g=0.0, c_r=1.0, levitate=False)).run(1e3, 50)
+
+
+def test_random_flights_invariants() -> None:
+    """300 random flights (parameters, inputs, states, J from 1e-3 to 1e7): contacts lie on
+    the circle, other ends inside it at rem; closed form and forced Taylor agree."""
+    rng = random.Random(7)
+    for _ in range(300):
+        p = RotorParams(m=rng.choice([1.0, 50.0]), c=rng.choice([0.0, 1400.0]),
+                        k=rng.choice([0.0, 9.8e5]), e_c=rng.choice([0.0, 1e-6, 0.3e-3]),
+                        phi=rng.uniform(-3, 3), c_r=rng.choice([0.7e-3, 1e-5]),
+                        g=rng.choice([0.0, 9.81]), levitate=rng.random() < 0.5)
+        J = 10 ** rng.uniform(-3, 7)
+        a = rng.choice([0.0, 0.0, 1.0])
+        F = rng.choice([0j, complex(rng.gauss(0, 300), rng.gauss(0, 300))])
+        T = rng.choice([0.0, rng.uniform(-100, 100)])
+        z = p.c_r * rng.choice([0.0, rng.random(), 1.0]) * cmath.exp(1j * rng.uniform(-4, 4))
+        v = complex(rng.gauss(0, 1), rng.gauss(0, 1)) * 10 ** rng.uniform(-6, 0)
+        Om = rng.choice([0.0, rng.uniform(-300, 300)])
+        rem = 10 ** rng.uniform(-5, -2)
+        psi = rng.uniform(-10, 10)
+        f = SpinFlight(p, J, a, F, T, z, v, psi, Om)
+        e = f.run(rem, BIG)
+        assert 0.0 <= e.duration <= rem
+        if e.event == "contact":
+            assert abs(abs(e.z) - p.c_r) <= 4e-16 * p.c_r
+        else:
+            assert e.duration == rem and abs(e.z) <= p.c_r * (1 + 1e-14)
+        if f.closed:
+            ei = SpinFlight(p, J, a, F, T, z, v, psi, Om, force_integration=True).run(rem, BIG)
+            assert ei.event == e.event
+            assert abs(ei.duration - e.duration) <= 1e-12 * rem
