@@ -37,7 +37,7 @@ j = z''' from the ODE at the point's state,
 
     G' = 2 Re(conj(z) v)/c_r^2,  G'' = 2(|v|^2 + Re(conj(z) a))/c_r^2,
     G''' = 2(3 Re(conj(v) a) + Re(conj(z) j))/c_r^2,
-    |G''''| <= G4 = 2(6 A^2 + 8 V Jm + c_r L)/c_r^2 on [s, s + tau],
+    |G''''| <= G4 = (6 A^2 + 8 V Jm + 2 c_r L)/c_r^2 on [s, s + tau],
 
 where V, W, D, A, Jm, L bound |v|, |Omega|, |Omega'|, |z''|, |z'''|, |z''''| on [s, s + tau]
 while |z| <= c_r (``bounds``: an a-priori bootstrap V >= |v(s)| + tau A(V, W), W >=
@@ -362,8 +362,8 @@ class SpinFlight:
         L = F2 / m + ec * (2.0 * D * D + 2.0 * W * B2 + B3 + 2.0 * W * (2.0 * W * D + B2)
                            + WD * WD)
         c2 = cr * cr
-        G3 = 2.0 * (6.0 * V * A + cr * Jm) / c2
-        G4 = 2.0 * (6.0 * A * A + 8.0 * V * Jm + cr * L) / c2
+        G3 = (6.0 * V * A + 2.0 * cr * Jm) / c2
+        G4 = (6.0 * A * A + 8.0 * V * Jm + 2.0 * cr * L) / c2
         return tau, G3, G4
 
     # ---------------------------------------------------------------- search
@@ -491,8 +491,8 @@ class SpinFlight:
             W2 = W * W
             Jm = ec * W * (3.0 * aal + W2)
             L = ec * (3.0 * aal * aal + W2 * (6.0 * aal + W2))
-            G3m = 2.0 * (6.0 * V * A + cr * Jm) * ic2
-            G4m = 2.0 * (6.0 * A * A + 8.0 * V * Jm + cr * L) * ic2
+            G3m = (6.0 * V * A + 2.0 * cr * Jm) * ic2
+            G4m = (6.0 * A * A + 8.0 * V * Jm + 2.0 * cr * L) * ic2
             c3 = g3 + 0.25 * tau * G4m + band3 * G3m + TINY
             u = safe_step(g0, g1, g2, c3, tau, work)
             if u is None:
