@@ -401,3 +401,53 @@ def test_random_flights_invariants() -> None:
             ei = SpinFlight(p, J, a, F, T, z, v, psi, Om, force_integration=True).run(rem, BIG)
             assert ei.event == e.event
             assert abs(ei.duration - e.duration) <= 1e-12 * rem
+
+
+def _z_derivs(ref: MpTaylor, t: mp.mpf, kmax: int = 4) -> list:
+    """z, z', ..., z^(kmax) at t from the reference's step polynomial (mp)."""
+    i = min(int(t / ref.h), len(ref.steps) - 1)
+    zc = ref.steps[i][0]
+    u = t - i * ref.h
+    out = []
+    for k in range(kmax + 1):
+        out.append(sum(mp.ff(j, k) * zc[j] * u ** (j - k) for j in range(k, len(zc))))
+    return out
+
+
+def _gap_derivs(d: list, cr: float) -> tuple:
+    """(G''', G'''') of G = |z|^2/c_r^2 - 1 from z's derivatives (Leibniz)."""
+    def gk(k):
+        return sum(mp.binomial(k, i) * (d[i] * mp.conj(d[k - i])).real for i in range(k + 1))
+    c2 = mp.mpf(cr) ** 2
+    return gk(3) / c2, gk(4) / c2
+
+
+@pytest.mark.parametrize("case", ["closed", "closed_spinup", "bearing", "bearing_spinup",
+                                  "bearing_hugeJ"])
+def test_bounds_hold_along_the_flight(case: str) -> None:
+    """bounds(|v(s)|, |Omega(s)|, tau) bounds |G'''| and |G''''| over [s, s + tau'] of the
+    reference trajectory (40 digits), at several s: the ingredient of the certificate."""
+    if case.startswith("closed"):
+        sc = drop_scene(T=60.0 if case == "closed_spinup" else 0.0, g=9.81,
+                        z=1e-4 + 1e-4j, v=0.02 - 0.01j, Om=184.2)
+        sc.p = sc.p.replace(c_r=0.01)  # stays inside over the window
+    else:
+        J = 1e7 if case == "bearing_hugeJ" else J0
+        T = 50.0 if case == "bearing_spinup" else 0.0
+        sc = Scene(_bearing(c=1400.0, g=9.81, c_r=2e-3), J, 1.0, 300.0 - 200.0j, T,
+                   2e-4 + 1e-4j, 0.03 - 0.01j, 0.4, 184.2)
+    f = sc.flight()
+    t_end = 0.03
+    ref = MpTaylor(sc, t_end + 0.02)
+    for s in (0.0, 0.0071, 0.0193, t_end):
+        z, v, _, Om = ref.at(s)
+        assert abs(z) < sc.p.c_r
+        tau, G3m, G4m = f.bounds(float(abs(v)), float(abs(Om)), f.horizon)
+        assert tau > 0.2 * f.horizon
+        worst3 = worst4 = 0.0
+        for i in range(41):
+            t = mp.mpf(s) + mp.mpf(tau) * i / 40
+            g3, g4 = _gap_derivs(_z_derivs(ref, t), sc.p.c_r)
+            worst3, worst4 = max(worst3, float(abs(g3))), max(worst4, float(abs(g4)))
+        assert worst3 <= G3m and worst4 <= G4m, (s, worst3, G3m, worst4, G4m)
+        assert worst4 >= 1e-3 * G4m  # and is not vacuous
