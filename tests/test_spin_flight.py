@@ -451,3 +451,25 @@ def test_bounds_hold_along_the_flight(case: str) -> None:
             worst3, worst4 = max(worst3, float(abs(g3))), max(worst4, float(abs(g4)))
         assert worst3 <= G3m and worst4 <= G4m, (s, worst3, G3m, worst4, G4m)
         assert worst4 >= 1e-3 * G4m  # and is not vacuous
+
+
+@pytest.mark.parametrize("name", ["closed", "closed_spinup", "integrated"])
+def test_grazing_work_stays_flat(name: str) -> None:
+    """Excursions of +-1e-6 ... +-1e-16 c_r around the peak: contact exactly when the
+    excursion beyond the wall exceeds the resolution (>= 1e-14 here), none when inside by
+    more than it, and the work at |excursion| <= 1e-12 stays within 1.6 times that at >= 1e-9."""
+    sc, _, _, r_star, t_end = _graze_setup(name)
+    works = {}
+    for k in range(6, 17):
+        for sgn in (-1, 1):
+            ex = sgn * 10.0 ** -k
+            p = sc.p.replace(c_r=float(r_star / (1 + mp.mpf(ex))))
+            e = sc.flight(p=p).run(t_end, BIG)
+            works[ex] = e.work
+            if ex >= 1e-14:
+                assert e.event == "contact", (ex, e)
+            elif ex <= -1e-14:
+                assert e.event is None, (ex, e)
+    deep = max(w for ex, w in works.items() if abs(ex) <= 1e-12)
+    shallow = max(w for ex, w in works.items() if abs(ex) >= 1e-9)
+    assert deep <= 1.6 * shallow, works

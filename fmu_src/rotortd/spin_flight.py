@@ -350,8 +350,9 @@ class SpinFlight:
                     break
                 tau *= 0.5
             else:
-                raise ContactWorkExceeded(f"free flight: no a-priori bound at |v| = {V0!r}",
-                                          work=0)
+                raise ContactWorkExceeded(
+                    f"free flight: no a-priori bound of the motion from |v| = {V0!r} m/s, "
+                    f"|Omega| = {W0!r} rad/s within 2^-200 of the horizon", work=0)
             F1 = cA * A + kA * V
             B2 = ec * (F1 + Fm * W) / J
         Jm = F1 / m + ec * (3.0 * W * D + B2 + W * W * W)
@@ -370,6 +371,8 @@ class SpinFlight:
     def run(self, rem: float, limit: int) -> FlightEnd:
         """Advance at most ``rem`` s; stop at the first contact; raise ContactWorkExceeded
         (with ``work``) if more than ``limit`` work units would be needed."""
+        if not rem >= 0.0:
+            raise ValueError(f"rem = {rem!r} s: it must be >= 0")
         work = Work()
         self._limit = limit
         if self.closed:
