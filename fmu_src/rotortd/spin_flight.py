@@ -206,7 +206,8 @@ class SpinFlight:
             self.zG0 = self.z0 + self.ec * self.E0
             self.wG0 = self.v0 + 1j * self.ec * self.Om0 * self.E0
         else:
-            self._steps: list[tuple[float, float, list[complex], list[complex], list[float],
+            self._steps: list[tuple[float, float,
+                                    list[tuple[complex, complex, complex, float, float]],
                                     float]] = []
             self._starts: list[float] = []
             self._k = 0  # index of the Taylor step of the last dense point
@@ -286,31 +287,31 @@ class SpinFlight:
         ho = _tail_step(abs(Oc[N - 2]), abs(Oc[N - 1]), TAYLOR_TOL * self.Om_scale, N - 1)
         hstep = min(hz, ho, STEP_MAX / self.w)
         t1 = t0 + h
-        self._steps.append((t1, hstep, zc, Ec, Oc, dpsi))
+        # Horner rows from the top degree N down to 0: z, v = z', E, Omega, psi - psi(t1)
+        rows = list(zip(
+            zc[::-1],
+            [0j, *(k * zc[k] for k in range(N, 0, -1))],
+            Ec[::-1],
+            [0.0, *Oc[::-1]],
+            [*(Oc[k - 1] / k for k in range(N, 0, -1)), 0.0],
+        ))
+        self._steps.append((t1, hstep, rows, dpsi))
         self._starts.append(t1)
 
     @staticmethod
-    def _poly(step: tuple[float, float, list[complex], list[complex], list[float], float],
+    def _poly(step: tuple[float, float, list[tuple[complex, complex, complex, float, float]],
+                          float],
               u: float) -> tuple[complex, complex, float, float, complex]:
-        """Evaluate a Taylor step at local offset u: (z, v, dpsi, Omega, E)."""
-        _, _, zc, Ec, Oc, dpsi0 = step
-        N = len(zc) - 1
-        z = zc[N]
-        v = N * zc[N]
-        for k in range(N - 1, 0, -1):
-            z = z * u + zc[k]
-            v = v * u + k * zc[k]
-        z = z * u + zc[0]
-        E = Ec[N]
-        for k in range(N - 1, -1, -1):
-            E = E * u + Ec[k]
-        n = len(Oc) - 1
-        Om = Oc[n]
-        ps = Oc[n] / (n + 1)
-        for k in range(n - 1, -1, -1):
-            Om = Om * u + Oc[k]
-            ps = ps * u + Oc[k] / (k + 1)
-        return z, v, dpsi0 + ps * u, Om, E
+        """Evaluate a Taylor step at local offset u: (z, v, dpsi, Omega, E) by Horner."""
+        z = v = E = 0j
+        Om = ps = 0.0
+        for cz, cv, cE, cO, cp in step[2]:
+            z = z * u + cz
+            v = v * u + cv
+            E = E * u + cE
+            Om = Om * u + cO
+            ps = ps * u + cp
+        return z, v, step[3] + ps, Om, E
 
     def _dense(self, s: float, work: Work) -> tuple[complex, complex, float, float, complex]:
         """The integrated state at s from the Taylor step that covers it."""
