@@ -12,9 +12,10 @@ contact with the clearance circle |z| = c_r.
 
 Trajectory
 ----------
-* Closed form (a == 0 and F_ext == 0, the drop scene): the mass centre z_G = z + e_c E moves on
-  a parabola and psi is quadratic, z(t) = z_G0 + z_G0' t - i g t^2/2 - e_c E0 e^{i(Omega0 t +
-  alpha t^2/2)}, alpha = T_drive/J; evaluated directly at every point (no drift).
+* Closed form (a == 0 and F_ext == 0, the drop scene; in general whenever F vanishes
+  identically): the mass centre z_G = z + e_c E moves on a parabola and psi is quadratic,
+  z(t) = z_G0 + z_G0' t - i g t^2/2 - e_c E0 e^{i(Omega0 t + alpha t^2/2)}, alpha =
+  T_drive/J; evaluated directly at every point (no drift).
 * Otherwise a Taylor method of order ORDER (24) with the coefficients from the recurrences of
   the ODE written for z_G (``_taylor``: two convolutions per order, conj(F) * E and
   Omega * E). Each step's length h makes the last two terms of the z and Omega series at most
@@ -180,11 +181,14 @@ class SpinFlight:
         self.g = p.g
         self.E0 = cmath.exp(1j * (self.psi0 + p.phi))
         self.alpha = self.T / self.J
-        self.closed = self.a == 0.0 and self.F_ext == 0j and not force_integration
         # F = F0 - ac v - ak z (N); z_G'' = F/m - i g
         self.F0 = self.a * p.bias_force + self.F_ext
         self.cA = self.a * p.c
         self.kA = self.a * p.k
+        # closed form whenever F vanishes identically (a == 0 and F_ext == 0, or a bearing
+        # with c = k = 0 and no bias)
+        self.closed = (self.F0 == 0j and self.cA == 0.0 and self.kA == 0.0
+                       and not force_integration)
         self.f0m = self.F0 / self.m - 1j * self.g  # constant part of z_G'' (m/s^2)
         self.f0m_abs = abs(self.f0m)
         self.F0_abs = abs(self.F0)
