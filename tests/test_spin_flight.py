@@ -473,3 +473,17 @@ def test_grazing_work_stays_flat(name: str) -> None:
     deep = max(w for ex, w in works.items() if abs(ex) <= 1e-12)
     shallow = max(w for ex, w in works.items() if abs(ex) >= 1e-9)
     assert deep <= 1.6 * shallow, works
+
+
+def test_closed_form_whole_flight_clear() -> None:
+    """A rotor spinning up about a mass centre at rest at the origin (g = 0): |z| = e_c for
+    ever, proved at once; the same scene integrated needs the search over every interval."""
+    p = RotorParams(g=0.0, levitate=False)
+    E0 = cmath.exp(1j * (0.3 + p.phi))
+    sc = Scene(p, J0, 0.0, 0j, 20.0, -p.e_c * E0, -1j * p.e_c * 184.2 * E0, 0.3, 184.2)
+    e = sc.flight().run(1e3, 10)
+    assert e.event is None and e.duration == 1e3 and e.work <= 3
+    assert abs(abs(e.z) - p.e_c) <= 1e-9 * p.e_c
+    assert e.Omega == pytest.approx(184.2 + 20.0 / J0 * 1e3, rel=1e-15)
+    with pytest.raises(ContactWorkExceeded):
+        sc.flight(force=True).run(1e3, 1000)

@@ -51,7 +51,9 @@ error 3 rho (rho = RHO_INT + k RHO_STEP relative, times the size of the coeffici
 G''' gets 3 rho of its bound), which also widens the bands of the wall classification.
 The step to p's first root (events.safe_step, the left end of its bracket) is safe: a
 contact before it would be a first exit at which the bound, valid up to it, is negative.
-Far from the wall tau = min(remaining, HORIZON/w) and the trajectory advances by tau.
+Far from the wall tau = min(remaining, HORIZON/w) and the trajectory advances by tau. In the
+closed form the whole flight is first tried at once: |z(t)| <= |z_G0| + |z_G0'| t + g t^2/2 +
+e_c < c_r on [0, rem] proves it clear with one evaluation.
 
 Resolution: a point is at the wall when G >= -TOL_G (16 eps: |z| within ~8 eps of c_r, a few
 ulp). There: moving outward with a resolvable excursion (G' above its rounding band and
@@ -450,6 +452,10 @@ class SpinFlight:
         band3 = 16.0 * EPS
         s = 0.0
         work.evals += 1
+        # the whole flight at once: |z| <= |z_G0| + |z_G0'| t + g t^2/2 + e_c
+        if abs(zG0) + rem * (abs(wG0) + 0.5 * g * rem) + ec < cr * (1.0 - 8.0 * EPS):
+            z, v, dpsi, Om, _ = self.state(rem, work)
+            return self._end(rem, z, v, dpsi, Om, None, work)
         dpsi = 0.0
         Om = Om0
         ecE = ec * E0
