@@ -357,9 +357,10 @@ def test_degenerate(kw: dict, a: float) -> None:
 # ------------------------------------------------------------------ work
 def test_work_bound_and_determinism() -> None:
     sc = Scene(_bearing(c_r=5e-3), J0, 1.0, 0j, 0.0, 1e-4, 0j, 0.0, 184.2)
-    e1 = sc.flight().run(0.05, BIG)
+    f = sc.flight()
+    e1 = f.run(0.05, BIG)
     e2 = sc.flight().run(0.05, BIG)
-    assert e1 == e2 and e1.event is None and e1.work > 50
+    assert e1 == e2 == f.run(0.05, BIG) and e1.event is None and e1.work > 50
     with pytest.raises(ContactWorkExceeded) as info:
         sc.flight().run(10.0, 40)
     assert 40 < info.value.work < 40 + 64

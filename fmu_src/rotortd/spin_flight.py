@@ -385,6 +385,9 @@ class SpinFlight:
         self._limit = limit
         if self.closed:
             return self._run_closed(rem, limit, work)
+        self._steps.clear()  # every run integrates afresh: its work does not depend on history
+        self._starts.clear()
+        self._k = 0
         cr = self.cr
         ic2 = 1.0 / (cr * cr)
         s = 0.0
