@@ -267,3 +267,18 @@ def test_normal_interpreter_exit_after_fmu_use(fmu_path: Path) -> None:
 
         warnings.warn(f"crash at interpreter exit in {len(exit_crashes)}/10 runs: "
                       f"{exit_crashes[0]}", stacklevel=1)
+
+
+def test_state_round_trip_with_the_spin_as_a_state(fmu_path: Path) -> None:
+    """integrate_spin: save at 140 ms of an AMB failure at 10 ms (g = 9.81, J = m R^2/2),
+    replay 60 ms through flight, sliding and rolling, and restore into a fresh instance made
+    without integrate_spin: every output of every step, the spin Omega_out included, bit
+    for bit."""
+    res = run_scenario(fmu_path, "state_roundtrip",
+                       params={"g": 9.81, "integrate_spin": True, "J": 0.04},
+                       n1=1400, n2=600, h=1e-4, t_off=0.01)
+    assert res["version"] == 2 and res["has_core"]
+    assert res["same_get_set"] and res["same_serialized"]
+    assert res["modes"] == [0, 1, 2] and res["n_impacts_at_save"] > 10
+
+
