@@ -20,6 +20,7 @@ from rotortd import (
     work_cap,
 )
 from rotortd.contact import LinearRub, QuadraticRub, Sliding, _monomial_integrals
+from rotortd.contact_step import closed_form_rub
 
 from tests.reference.direct import direct_simulate
 from tests.reference.mp_reference import (
@@ -247,12 +248,16 @@ def test_extrapolation_error_ratio_is_nan_when_any_component_is() -> None:
     assert gbs._error_ratio([1.0, 2.0, math.nan], [1.5, 2.0, 0.0], [1.0, 1.0]) == 0.5
 
 
+class _IntegratingCore(TouchdownCore):
+    """A core that takes no rub in closed form (nor the lock): it integrates the sliding."""
+
+    RUB_CLOSED_FORM = False
+
+
 def _integrating_twin(core: TouchdownCore) -> TouchdownCore:
-    """A copy of core that refuses the linearised rub (and so the lock): it integrates."""
-    twin = TouchdownCore(core.params)
+    """A copy of core that integrates the sliding near and on the rub."""
+    twin = _IntegratingCore(core.params)
     twin.set_state(core.get_state())
-    twin._linear_rub = lambda E: None  # type: ignore[method-assign]
-    twin._locked = False
     return twin
 
 
@@ -284,16 +289,22 @@ def test_linearised_rub_is_refused_outside_its_error_budget() -> None:
     admits; at 0.2 s (deviation ~3e-4) both refuse. Neither admits a saddle or the wrong
     slip sign."""
     core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
+
+    def closed_form() -> object:
+        st, wf = core.state, core.wall_forces
+        return closed_form_rub(wf, forward_rub_equilibria(wf), st.theta, st.dtheta,
+                               cmath.exp(1j * st.psi), st.slip)
+
     _run(core, 0.2, 1e-3)
-    assert core._linear_rub(cmath.exp(1j * core.state.psi)) is None
+    assert closed_form() is None
     _run(core, 0.3, 1e-3)
     st, E = core.state, cmath.exp(1j * core.state.psi)
     stable = next(e for e in forward_rub_equilibria(core.wall_forces) if e.stable)
     assert LinearRub.near(core.wall_forces, stable, st.theta, st.dtheta, E, st.slip) is None
-    assert isinstance(core._linear_rub(E), QuadraticRub)
+    assert isinstance(closed_form(), QuadraticRub)
     _run(core, 0.45, 1e-3)
     st, E = core.state, cmath.exp(1j * core.state.psi)
-    assert core._linear_rub(E) is not None
+    assert closed_form() is not None
     wf = core.wall_forces
     stable, saddle = sorted(forward_rub_equilibria(wf), key=lambda e: not e.stable)
     assert LinearRub.near(wf, saddle, st.theta, st.dtheta, E, st.slip) is None

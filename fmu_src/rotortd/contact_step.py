@@ -24,7 +24,7 @@ from .rub import (
 )
 from .scaled import wrap_angle
 from .sliding import Sliding
-from .wall import SegmentEnd
+from .wall import SegmentEnd, WallForces
 
 LOCK_TOL = 1e-14
 """A sliding state on the linearised rub (contact.LinearRub) whose snap_error is at most
@@ -39,6 +39,11 @@ at the rub cost 0.19 s CPU)."""
 
 class ContactSteps:
     """Sustained contact (mixin of TouchdownCore)."""
+
+    RUB_CLOSED_FORM = True
+    """Take sliding on or near a stable forward rub in closed form (LockedRub, LinearRub,
+    QuadraticRub). False integrates it like any sliding: the check of the closed forms
+    (tests/test_contact.py) runs a core with it off beside one with it on."""
 
     def _enter_contact(self) -> None:
         """Switch to sustained contact at the current (on-wall) state."""
@@ -184,6 +189,8 @@ class ContactSteps:
         """The sliding segment on or near a stable forward rub in closed form: the rigid
         rotation when locked; else, if ``linearise``, the linearised motion when the
         state admits it (locking first when the snap is below LOCK_TOL); else None."""
+        if not self.RUB_CLOSED_FORM:
+            return None
         if self._locked:
             return LockedRub(self._wf, self._theta, self._dtheta, E, self._slip)
         lin = self._linear_rub(E) if linearise else None
@@ -206,18 +213,25 @@ class ContactSteps:
         return not (sticky or refused)
 
     def _linear_rub(self, E: complex) -> LinearRub | QuadraticRub | None:
-        """The closed-form sliding near a stable forward rub: linearised when within
-        LINEAR_TOL and its error budget holds (LinearRub.near), else to second order when
-        within QUAD_TOL and its budget holds (QuadraticRub.near); None otherwise."""
-        wf = self._wf
-        th, dth, slip = self._theta, self._dtheta, self._slip
-        for eq in self._rub_equilibria():  # (none when q0 != 0)
-            dev = rub_deviation(wf, eq, th, dth, E, slip, QUAD_TOL)
-            if dev is None:
-                continue
-            lin = LinearRub.admit(wf, eq, th, dth, slip, dev)
-            if lin is None:
-                lin = QuadraticRub.admit(wf, eq, th, dth, slip, dev)
-            if lin is not None:
-                return lin
-        return None
+        """``closed_form_rub`` at the current sliding state under the held inputs."""
+        return closed_form_rub(self._wf, self._rub_equilibria(), self._theta, self._dtheta,
+                               E, self._slip)
+
+
+def closed_form_rub(wf: WallForces, equilibria: list[RubEquilibrium], theta: float,
+                    dtheta: float, E: complex, slip: float) -> LinearRub | QuadraticRub | None:
+    """The closed-form sliding near a stable forward rub from the sliding state (theta,
+    theta', slip) with the phasor E under the wall forces ``wf`` and their rub
+    ``equilibria``: linearised when within LINEAR_TOL and its error budget holds
+    (LinearRub.admit), else to second order when within QUAD_TOL and its budget holds
+    (QuadraticRub.admit); None otherwise."""
+    for eq in equilibria:  # (none when q0 != 0)
+        dev = rub_deviation(wf, eq, theta, dtheta, E, slip, QUAD_TOL)
+        if dev is None:
+            continue
+        lin = LinearRub.admit(wf, eq, theta, dtheta, slip, dev)
+        if lin is None:
+            lin = QuadraticRub.admit(wf, eq, theta, dtheta, slip, dev)
+        if lin is not None:
+            return lin
+    return None
