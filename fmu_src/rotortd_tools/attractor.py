@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from rotortd import MODE_FREE, MODE_ROLLING, MODE_SLIDING, STATUS_OK, TouchdownCore
+from rotortd.scaled import wrap_angle
 
 CHAPTER_REGIMES = ("free whirl", "impacting", "rub/sliding", "dry whip/rolling")
 """The chapter's coarse regimes (``chapter_regime``)."""
@@ -39,12 +40,12 @@ class Recorder:
 
     def step(self, core: TouchdownCore, h: float, Omega: float, t_rec0: float) -> int:
         """Advance the core by h (s) and record; return the step status."""
-        t0, psi0, mode = core.t, math.remainder(core.psi, 2.0 * math.pi), core.mode
+        t0, psi0, mode = core.t, wrap_angle(core.psi), core.mode
         rep = core.step(h, Omega)
         for imp in rep.impacts:
             ang = cmath.phase(imp.z) - (psi0 + Omega * (imp.t - t0))
             self.times.append((imp.t - t_rec0) * Omega)
-            self.angles.append(math.remainder(ang, 2.0 * math.pi))
+            self.angles.append(wrap_angle(ang))
             self.speeds.append(imp.rdot / (self.c_r * Omega))
             self.r_max = max(self.r_max, 1.0)
         t_prev = t0
@@ -96,7 +97,7 @@ def detect_period(angles: Sequence[float], speeds: Sequence[float], tol: float,
         m = len(a) - n
         if m < max(2, n):
             break
-        da = np.abs(np.remainder(a[n:] - a[:-n] + math.pi, 2.0 * math.pi) - math.pi)
+        da = np.abs([wrap_angle(float(x)) for x in a[n:] - a[:-n]])
         dv = np.abs(v[n:] - v[:-n])
         if float(max(da.max(), dv.max())) < tol:
             return n
