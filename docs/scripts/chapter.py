@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import itertools
 import json
-import math
 import time
 from pathlib import Path
 
 import matplotlib
+from rotortd.scaled import wrap_angle
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -66,9 +66,7 @@ def rub_numbers() -> dict:
         "stable_branch": f"0 < gamma <= {g_fold:.6f} (stable node/focus of the sliding motion)",
         "saddle_branch": f"{g_beb:.6f} < gamma <= {g_fold:.6f} (saddle), born at the BEB with N=0",
         "saddle_N_at_gamma_beb_plus_1e-4_1e-6_1e-8": saddle_N,
-        "saddle_alpha_minus_arg_Ustar_at_beb_plus_1e-8": math.remainder(
-            saddle_alpha - np.angle(Us), 2 * math.pi
-        ),
+        "saddle_alpha_minus_arg_Ustar_at_beb_plus_1e-8": wrap_angle(saddle_alpha - np.angle(Us)),
         "examples": {
             f"{g}": [
                 {"alpha": e.alpha, "N": e.N, "stable": e.stable, "eig": [str(v) for v in e.eig]}

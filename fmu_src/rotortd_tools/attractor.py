@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from rotortd import MODE_FREE, MODE_ROLLING, MODE_SLIDING, STATUS_OK, TouchdownCore
+from rotortd.scaled import wrap_angle
 
 CHAPTER_REGIMES = ("free whirl", "impacting", "rub/sliding", "dry whip/rolling")
 """The chapter's coarse regimes (``chapter_regime``)."""
@@ -57,7 +58,7 @@ class Recorder:
              T_drive: float | None = None) -> int:
         """Advance the core by h (s) and record; return the step status. With ``T_drive``
         (N m) the core is a SpinCore: the impact angles use its spin at the step start."""
-        t0, psi0, mode = core.t, math.remainder(core.psi, 2.0 * math.pi), core.mode
+        t0, psi0, mode = core.t, wrap_angle(core.psi), core.mode
         if T_drive is None:
             W = Omega
             rep = core.step(h, Omega)
@@ -67,7 +68,7 @@ class Recorder:
         for imp in rep.impacts:
             ang = cmath.phase(imp.z) - (psi0 + W * (imp.t - t0))
             self.times.append((imp.t - t_rec0) * Omega)
-            self.angles.append(math.remainder(ang, 2.0 * math.pi))
+            self.angles.append(wrap_angle(ang))
             self.speeds.append(imp.rdot / (self.c_r * Omega))
             self.r_max = max(self.r_max, 1.0)
         t_prev = t0
@@ -122,7 +123,7 @@ def detect_period(angles: Sequence[float], speeds: Sequence[float], tol: float,
         m = len(a) - n
         if m < max(2, n):
             break
-        da = np.abs(np.remainder(a[n:] - a[:-n] + math.pi, 2.0 * math.pi) - math.pi)
+        da = np.abs([wrap_angle(float(x)) for x in a[n:] - a[:-n]])
         dv = np.abs(v[n:] - v[:-n])
         if float(max(da.max(), dv.max())) < tol:
             return n

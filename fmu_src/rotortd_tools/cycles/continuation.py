@@ -7,13 +7,12 @@ map (scaled co-rotating; gamma dimensionless).
 from __future__ import annotations
 
 import itertools
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg
 import scipy.optimize
-from rotortd.scaled import chapter_params
+from rotortd.scaled import chapter_params, wrap_angle
 
 from rotortd_tools.cycles.closed_form import labelled_cycles, max_radius_in_flight, period_condition
 from rotortd_tools.cycles.fixed_points import (
@@ -88,7 +87,7 @@ def _correct(
         if np.max(np.abs(g)) < tol:
             return y, fl, DF, Jx
         y = y - np.linalg.solve(np.vstack([DF, t]), g)
-        y[0] = math.remainder(y[0], 2.0 * math.pi)
+        y[0] = wrap_angle(y[0])
     raise NewtonFailed("corrector did not converge")
 
 

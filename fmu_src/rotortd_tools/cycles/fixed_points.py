@@ -6,14 +6,13 @@ the core on a cycle. ``find_period_one_cycle`` is what the sweep's ``cycle`` sta
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from rotortd import RotorParams, ScaledParams, TouchdownCore
 from rotortd.scaled import CHAPTER_C_R as C_R
 from rotortd.scaled import CHAPTER_OMEGA as OMEGA
-from rotortd.scaled import chapter_params, si_params
+from rotortd.scaled import chapter_params, si_params, wrap_angle
 
 from rotortd_tools.cycles.closed_form import labelled_cycles, max_radius_in_flight
 from rotortd_tools.cycles.impact_map import Flight, ImpactMap, NoImpact, post_impact_state
@@ -27,7 +26,7 @@ def map_residual(P: ImpactMap, x: np.ndarray) -> tuple[np.ndarray, Flight]:
     """F(x) = P(x) - x (angle difference wrapped to (-pi, pi]) and the flight."""
     fl = P.flight(x)
     F = fl.x1 - x
-    F[0] = math.remainder(F[0], 2.0 * math.pi)
+    F[0] = wrap_angle(F[0])
     return F, fl
 
 
@@ -53,7 +52,7 @@ def newton_fixed_point(
         lam = 1.0
         while lam > 1e-4:
             xn = x + lam * dx
-            xn[0] = math.remainder(xn[0], 2.0 * math.pi)
+            xn[0] = wrap_angle(xn[0])
             if xn[1] >= 0.0:  # post-impact motion must point inward
                 lam *= 0.5
                 continue

@@ -19,7 +19,7 @@ from rotortd.events import Contact, ContactLocator, Work
 from rotortd.flight import FlightModel
 from rotortd.impact import reset
 from rotortd.scaled import CHAPTER_OMEGA as OMEGA
-from rotortd.scaled import si_params
+from rotortd.scaled import si_params, wrap_angle
 
 from rotortd_tools.cycles.flow import ScaledFlow, real_jac, to_real
 
@@ -196,6 +196,6 @@ class ImpactMap:
             dx[j] = eps
             fp, fm_ = self(x + dx), self(x - dx)
             diff = fp - fm_
-            diff[0] = math.remainder(diff[0], 2.0 * math.pi)
+            diff[0] = wrap_angle(diff[0])
             J[:, j] = diff / (2.0 * eps)
         return J

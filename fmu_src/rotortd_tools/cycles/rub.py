@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from rotortd import ScaledParams, WallForces, forward_rub_equilibria
 from rotortd.scaled import CHAPTER_OMEGA as OMEGA
-from rotortd.scaled import si_params
+from rotortd.scaled import si_params, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ def rub_equilibria_scaled(sp: ScaledParams) -> list[RubPoint]:
         b1 = sp.gamma + 2.0 * mu
         root = cmath.sqrt(b1 * b1 / 4.0 - a1)
         eig = (-b1 / 2.0 + root, -b1 / 2.0 - root)
-        alpha = math.remainder(sp.phi - x, 2.0 * math.pi)
+        alpha = wrap_angle(sp.phi - x)
         out.append(RubPoint(sp.gamma, alpha, N, max(e.real for e in eig) < 0.0, eig))
     return sorted(out, key=lambda e: not e.stable)
 
