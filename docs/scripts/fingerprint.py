@@ -836,12 +836,31 @@ def _unit_of(path: str, units: dict[str, float]) -> float | None:
     return None
 
 
+SCHEMA_LEAVES = ("version",)
+"""Leaves of a saved state that are bookkeeping of its schema, not physics: left out."""
+NULL_WHEN_HELD = ("J", "spin")
+"""Leaves that a held-speed state holds as null or lacks, by schema version (the core's
+J since rotortd-state 2, the adapter's spin until rotortd-fmu-state 1): left out when null."""
+
+
+def physics_leaves(value: Any) -> dict[str, Any]:
+    """``flatten(value)`` without the schema's bookkeeping (SCHEMA_LEAVES, and the
+    NULL_WHEN_HELD leaves when null), so that a schema version bump compares equal."""
+    out = {}
+    for key, x in flatten(value).items():
+        last = key.rsplit(".", 1)[-1]
+        if last in SCHEMA_LEAVES or (last in NULL_WHEN_HELD and x is None):
+            continue
+        out[key] = x
+    return out
+
+
 def compare_final(v: Verdict, a: dict[str, Any], b: dict[str, Any], units: dict[str, float],
                   what: str) -> None:
     """Final state or counters: every leaf, floats bit-exact (as float.hex). A differing
     leaf that is not a float (a flag, an integer, a missing key) counts as infinitely
     different unless it is a count or a mode."""
-    fa, fb = flatten(a), flatten(b)
+    fa, fb = physics_leaves(a), physics_leaves(b)
     for key in sorted(set(fa) | set(fb), key=lambda k: (k not in fa, k)):
         x, y = fa.get(key, "<absent>"), fb.get(key, "<absent>")
         if x == y:
@@ -866,7 +885,8 @@ def compare_job(job: tuple[str, str, str], ra: dict[str, Any], rb: dict[str, Any
         v.first = "error"
         v.max_scaled = math.inf
         return v
-    if (ra["hash"], ra["state"], ra["counters"]) == (rb["hash"], rb["state"], rb["counters"]):
+    if ((ra["hash"], physics_leaves(ra["state"]), ra["counters"])
+            == (rb["hash"], physics_leaves(rb["state"]), rb["counters"])):
         v.identical = True
         return v
     units = scales(spec)
