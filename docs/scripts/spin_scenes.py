@@ -257,6 +257,9 @@ def drop_scene(r: dict) -> dict[str, Any]:
             "amplification_A": amp, "test_tolerance_rad_s": tol,
             "mean_Omega_last_0.1_core": float(core["Omega"][last].mean()),
             "mean_Omega_last_0.1_ref": float(ref_om[last].mean()),
+            "d_mean_Omega_last_0.1": float(core["Omega"][last].mean() - ref_om[last].mean()),
+            "t_of_max_dOmega": float(t[int(np.argmax(np.abs(diff)))]),
+            "max_abs_dOmega_rolling_from_0.1": float(np.max(np.abs(diff[t >= 0.1]))),
             "max_abs_Omega_1e-3_vs_1e-4": float(np.max(np.abs(coarse["Omega"]
                                                                - core["Omega"][::10]))),
             "rolling_oscillation_ref": osc,
