@@ -152,7 +152,8 @@ def balances() -> dict[str, Any]:
             "impacts": core.n_impacts,
             "L_rel_change": abs(b1["L"] - b0["L"]) / abs(b0["L"]),
             "T_rel_change": abs(b1["T"] - b0["T"]) / b0["T"],
-            "E_diss_rel": core.E_diss / b0["T"]}
+            "E_diss_rel": core.E_diss / b0["T"],
+            "energy_residual_rel": abs(b1["T"] - b0["T"] + core.E_diss) / b0["T"]}
     for T in (0.0, 5.0):
         core = SpinCore.on_steady_whirl(P_G, 184.2, J=J_HALF)
         b0 = _body(core)
