@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from .scenes import RECORDED, SCENES, Scene
+from .scenes import ALL_SCENES, RECORDED, Scene
 from .tbb import load_libtbb
 
 Result = dict[str, np.ndarray]
@@ -217,5 +217,5 @@ ENGINES = {"fmpy": run_fmpy_ssp, "libcosim": run_libcosim, "ecospy": run_ecospy,
 def run(engine: str, scene: str, ssp: Path, step: float | None = None,
         stop: float | None = None) -> Result:
     """Run a scene on an engine."""
-    sc = SCENES[scene]
+    sc = ALL_SCENES[scene]
     return ENGINES[engine](ssp, sc, sc.step if step is None else step, stop)
