@@ -383,18 +383,19 @@ def test_ecos_cli_constant_torque_equals_bearing_alone(systems: Path) -> None:
     full = run_engine(systems, "ecospy", "drop_torque")
     alone = run_alone(systems, "ecospy", "drop_torque", full, h)
     assert np.array_equal(ec["RotorTouchdown.n_impacts"], alone["RotorTouchdown.n_impacts"])
-    for col in (OMEGA, "RotorTouchdown.r_rel", "RotorTouchdown.x"):
-        scale = np.maximum(1e-3 if col == "RotorTouchdown.x" else 1.0, np.abs(alone[col]))
+    for col in (OMEGA, "RotorTouchdown.r_rel"):  # (x, y: 6 decimals, 1e-6 m, in the CSV)
+        scale = np.maximum(1.0, np.abs(alone[col]))
         assert np.max(np.abs(ec[col] - alone[col]) / scale) < 1e-5, col
 
 
 PI_STEPS = (4e-4, 2e-4, 1e-4, 5e-5)
-PI_LIMIT = {0.2: 168.35494329, 0.35: 63.12398411}
-"""Omega_out [rad/s] of the drop scene with the PI drive in the limit h -> 0, at 0.2 s
-(after 26 impacts) and 0.35 s (in dry whip, 298 impacts): the in-process master
-(rotortd_cosim.coupling.spin_jacobi) at h = 1e-6 and 5e-6 s, extrapolated as O(h)
+PI_LIMIT = {0.1: 183.96427410, 0.2: 168.35494329, 0.35: 63.12398411}
+"""Omega_out [rad/s] of the drop scene with the PI drive in the limit h -> 0: at 0.1 s (the
+failure; free whirl with the AMB on), 0.2 s (after 26 impacts) and 0.35 s (in dry whip,
+298 impacts), from the in-process master (rotortd_cosim.coupling.spin_jacobi) extrapolated
+as O(h): from h = 1e-5 and 5e-6 s at 0.1 s, from 5e-6 and 1e-6 s at 0.2 and 0.35 s
 (Omega(1e-6) = 168.35479758 and 63.12384373; the extrapolation moves them by 1.5e-4, the
-smallest error tested here is 7e-3; docs/cosimulation.md)."""
+smallest error tested here is 3e-3; docs/cosimulation.md)."""
 
 
 @pytest.mark.slow
@@ -402,17 +403,23 @@ smallest error tested here is 7e-3; docs/cosimulation.md)."""
 def test_pi_coupling_error_is_first_order(systems: Path, engine: str) -> None:
     """With the PI drive the coupling is explicit in T_drive (held over a step, computed
     from the Omega of the step before): the error against the small-step limit is O(h).
-    Fitted log-log slope of |Omega_out(t) - limit| over h = 4e-4 ... 5e-5 s, at 0.2 s and
-    in the dry whip at 0.35 s, within [0.8, 1.2]; the same impacts at every step."""
-    errs: dict[float, list[float]] = {t: [] for t in PI_LIMIT}
+    Fitted log-log slope of |Omega_out(t) - limit| over h = 4e-4 ... 5e-5 s within
+    [0.8, 1.2]: at 0.1 s on every engine; on libcosim and ecospy also at 0.2 s and in the
+    dry whip at 0.35 s, with the same 298 impacts at every step. FMPy's first step (every
+    connector at 0: amb_on = T_drive = 0 in the bearing, Omega_in = 0 in the drivetrain,
+    whose PI saturates) is an O(h) perturbation too, but the impacts after the failure
+    amplify it: 298 ... 318 impacts and no monotone error at these steps (measured at 0.2 s:
+    0.14, 0.56, 0.056, 0.047 rad/s), so FMPy is checked at the failure only."""
+    times = (0.1,) if engine == "fmpy" else tuple(PI_LIMIT)
+    errs: dict[float, list[float]] = {t: [] for t in times}
     impacts = []
     for h in PI_STEPS:
         res = run_engine(systems, engine, "drop", step=h)
         _check_reached(res, DROP.stop_time, h)
         impacts.append(res["RotorTouchdown.n_impacts"][-1])
-        for t, lim in PI_LIMIT.items():
-            errs[t].append(abs(float(res[OMEGA][round(t / h) - 1]) - lim))
-    assert len(set(impacts)) == 1
+        for t in times:
+            errs[t].append(abs(float(res[OMEGA][round(t / h) - 1]) - PI_LIMIT[t]))
+    assert engine == "fmpy" or set(impacts) == {298}
     for t, e in errs.items():
         slope = np.polyfit(np.log(PI_STEPS), np.log(e), 1)[0]
         assert 0.8 <= slope <= 1.2, (engine, t, e, slope)
@@ -422,14 +429,15 @@ def test_pi_coupling_error_is_first_order(systems: Path, engine: str) -> None:
 @pytest.mark.slow
 def test_spin_balance_exact_without_imbalance(systems: Path) -> None:
     """Bearing alone with integrate_spin, e_c = 0 (no imbalance reaction), AMB off from the
-    start under gravity (falls, impacts, contact), T_drive = 2 N m: the rigid body's spin
+    start under gravity (falls, 14 impacts with d = 0.3, then contact), T_drive = 2 N m:
+    the rigid body's spin
     balance J (Omega_out - Omega0) = sum of h (T_drive + T_f) holds to round-off (the
     contact impulses are the core's error-controlled quadratures)."""
     code = (
         "import json, math, numpy as np\n"
         "from fmpy import simulate_fmu\n"
         f"r = simulate_fmu(r'{systems.parent / 'RotorTouchdown.fmu'}', stop_time=0.05,\n"
-        "    output_interval=1e-4, start_values={'g': 9.81, 'amb_on': 0.0, 'e_c': 0.0,\n"
+        "    output_interval=1e-4, start_values={'g': 9.81, 'amb_on': 0.0, 'e_c': 0.0, 'd': 0.3,\n"
         "    'integrate_spin': True, 'J': 0.04, 'T_drive': 2.0},\n"
         "    output=['Omega_out', 'T_f', 'mode', 'n_impacts'])\n"
         "res = 0.04 * (r['Omega_out'][-1] - 184.2) - 1e-4 * math.fsum(2.0 + r['T_f'][1:])\n"

@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -139,6 +140,8 @@ def coupling_study() -> Path:
         ax[0].loglog(hs, [r[key] for r in rows], "o-", label=label)
     ax[0].loglog(hs, [rows[2]["err_max"] * h / 1e-4 for h in hs], "k:", label="O(h)")
     ax[0].axhline(0.1, color="grey", lw=0.6)
+    ax[0].xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax[0].set_xticks(hs, [f"{h:.0e}" for h in hs])
     ax[0].set(xlabel="communication step h [s]", ylabel="|Omega_out - limit| [rad/s]",
               title="drop scene, PI drive, spin a state of the bearing")
     ax[0].legend()
