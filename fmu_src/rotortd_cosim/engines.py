@@ -16,6 +16,8 @@ Engine differences handled here (see docs/cosimulation.md):
   each doStep gets the difference of two time points converted to seconds (an ulp off h
   now and then: rotortd_cosim.alone._clock). Its step call returns False after a
   component's fmi2Discard, and the execution would go on with frozen outputs: refused.
+  ecospy goes on after a Discard too, printing the error, and its step returns only the
+  time: the runner cannot refuse it.
 - ecos: the bundled binaries need chmod +x; the native CLI needs LD_PRELOAD of libpython.
   Both ecospy and the CLI need libtbb.so.12: from the environment's ``tbb`` package,
   loaded by :func:`.tbb.load_libtbb` before ecospy is imported, and put on
