@@ -1,10 +1,15 @@
 """System-level co-simulation: RotorTouchdown + Drivetrain + TouchdownEvents from SSP files.
 
-Every engine run happens in a subprocess (``python -m rotortd_cosim.run``): PythonFMU FMUs
-share the host's interpreter and can crash it at exit. Quick group: FMPy's SSP master,
-libcosimpy and ecospy on the three scenes; slow group: the native ecos CLI and the
-integrate_spin coupling check. ecospy and the CLI need libtbb.so.12, from the tbb package of
-the test extra (rotortd_cosim.tbb loads it in the engine's process).
+The scenes couple the drivetrain to the bearing with the spin as a state of the bearing
+(``integrate_spin``, J = the whole spinning inertia; ``Drivetrain.follow_speed``;
+``Omega_out -> Omega_in``, ``T_drive -> T_drive``). Every engine run happens in a
+subprocess (``python -m rotortd_cosim.run``): PythonFMU FMUs share the host's interpreter and
+can crash it at exit. Quick group: FMPy's SSP master, libcosimpy and ecospy on the three
+scenes, the passive-drive equality with the bearing run alone on each, the in-process master
+against ecospy; slow group: the native ecos CLI, the first-order coupling error with the PI
+drive on each engine, the exact spin balance with e_c = 0, the core stall at the run-down's
+lift-off (strict xfail). ecospy and the CLI need libtbb.so.12, from the tbb package of the
+test extra (rotortd_cosim.tbb loads it in the engine's process).
 """
 
 from __future__ import annotations
@@ -22,10 +27,20 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "fmu_src"))
 
 import rotortd  # noqa: E402
-from rotortd_cosim.scenes import DROP, FORCE, RUNDOWN, T_FAIL  # noqa: E402
+from rotortd_cosim.scenes import (  # noqa: E402
+    ALL_SCENES,
+    DROP,
+    DROP_TORQUE,
+    FORCE,
+    J_ROTOR,
+    RUNDOWN,
+    T_FAIL,
+)
 from rotortd_drive import MOTOR_PI, DriveCore, DriveParams  # noqa: E402
 
-J = 0.04
+J = J_ROTOR
+OMEGA = "RotorTouchdown.Omega_out"   # the spin: a state of the bearing
+ENGINES = ["fmpy", "libcosim", "ecospy"]
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +53,7 @@ def systems(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
     out = tmp_path_factory.mktemp("cosim")
     build.build_all(out, check=False)
-    write_all(out, out / "systems")
+    write_all(out, out / "systems", ALL_SCENES)
     return out / "systems"
 
 
@@ -57,6 +72,24 @@ def run_engine(systems: Path, engine: str, scene: str, stop: float | None = None
     return dict(np.load(out))
 
 
+def run_alone(systems: Path, engine: str, scene: str, coupled: dict[str, np.ndarray],
+              step: float, timeout: float = 300.0) -> dict[str, np.ndarray]:
+    """The bearing FMU alone (rotortd_cosim.alone, in a subprocess) fed the inputs the
+    engine's coupled run gave it, with that engine's clock and first step."""
+    src = systems / f"coupled_{engine}_{scene}.npz"
+    np.savez(src, **coupled)
+    out = systems / f"alone_{engine}_{scene}.npz"
+    cmd = [sys.executable, "-m", "rotortd_cosim.alone", scene,
+           str(systems.parent / "RotorTouchdown.fmu"), str(src), str(out), "--step",
+           repr(step)]
+    cmd += {"fmpy": ["--fmpy"], "libcosim": ["--ns-clock"]}.get(engine, [])
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT,
+                          env=_env())
+    assert proc.returncode == 0 and "DONE" in proc.stdout, proc.stdout[-3000:] + \
+        proc.stderr[-3000:]
+    return dict(np.load(out))
+
+
 def _env() -> dict[str, str]:
     import os
 
@@ -70,33 +103,70 @@ def _check_reached(res: dict[str, np.ndarray], stop: float, step: float) -> None
 
 
 # ---------------------------------------------------------------------------- physics checks
-def momentum_residuals(res: dict[str, np.ndarray], step: float, omega0: float
-                       ) -> tuple[float, float]:
-    """(a) J (Omega - Omega0) - (H_motor + H_drag + H_bearing) at the end [N m s];
-    (b) H_bearing at the end minus the sum of the T_f the bearing reported, h T_f,k over
-    all steps but the last (the Jacobi master feeds step k's T_f into step k+1) [N m s]."""
-    d = "Drivetrain."
-    h_tot = res[d + "H_motor"][-1] + res[d + "H_drag"][-1] + res[d + "H_bearing"][-1]
-    a = J * (res[d + "Omega"][-1] - omega0) - h_tot
-    b = res[d + "H_bearing"][-1] - step * math.fsum(res["RotorTouchdown.T_f"][:-1])
+def coupling_residuals(res: dict[str, np.ndarray], fmpy: bool) -> tuple[float, float]:
+    """The Jacobi coupling of the spin, exact: (a) the drivetrain's Omega (= Omega_in, held)
+    after step k is the bearing's Omega_out after step k - 1 [rad/s]; (b) its T_drive is
+    T_motor + T_drag [N m]. FMPy's first step sees Omega_in = 0 (connectors start at 0)."""
+    om, d = res[OMEGA], res["Drivetrain.Omega"]
+    a = float(np.max(np.abs(d[1:] - om[:-1])))
+    if fmpy:
+        a = max(a, abs(float(d[0])))
+    b = float(np.max(np.abs(res["Drivetrain.T_drive"] - res["Drivetrain.T_motor"]
+                            - res["Drivetrain.T_drag"])))
     return a, b
+
+
+def spin_balance(res: dict[str, np.ndarray], step: float, rotor: dict[str, float]
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Per step k >= 1: the residual J (Omega_k - Omega_k-1) - h (T_drive,k-1 + T_f,k) of
+    the spin's balance [N m s] without the imbalance's reaction torque
+    e_c Im(conj(F_amb + F_ext + F_c) E) (MODEL.md 6, eq. 7; not an output), and a bound on
+    that torque's impulse [N m s]:
+    h e_c (amb_on (m g [levitate] + k c_r + c |v|) + |F_ext| + sqrt(1 + mu^2) F_n), with
+    |v| taken as twice the larger of its values at the step's ends (a margin: the
+    speed within a step is not recorded) and |F_c| <= sqrt(1 + mu^2) N (Coulomb)."""
+    p = rotortd.RotorParams()
+    e_c, k, c, m = (rotor.get(n, getattr(p, n)) for n in ("e_c", "k", "c", "m"))
+    mg = m * rotor.get("g", 0.0) if rotor.get("levitate", True) else 0.0
+    om, r, ev = res[OMEGA], "RotorTouchdown.", "TouchdownEvents."
+    resid = J * np.diff(om) - step * (res["Drivetrain.T_drive"][:-1] + res[r + "T_f"][1:])
+    speed = np.hypot(res[r + "vx"], res[r + "vy"])
+    vmax = np.maximum(speed[1:], speed[:-1])
+    amb = res[ev + "amb_on"][:-1]                 # held over step k: the row before
+    f_ext = np.hypot(res[ev + "F_x"][:-1], res[ev + "F_y"][:-1])
+    bound = step * e_c * (amb * (mg + k * p.c_r + 2.0 * c * vmax) + f_ext
+                          + math.hypot(1.0, p.mu) * res[r + "F_n"][1:])
+    return resid, bound
+
+
+def check_spin_balance(res: dict[str, np.ndarray], step: float, rotor: dict[str, float]
+                       ) -> None:
+    """Every step's spin change is the drive and friction torques' up to the imbalance's
+    reaction (bounded), and over the run the friction impulse [N m s] is well above what
+    the residuals add up to (the check is not vacuous)."""
+    resid, bound = spin_balance(res, step, rotor)
+    bound = bound + 1e-14 * J * np.abs(res[OMEGA][1:])   # round-off of the spin's update
+    assert np.all(np.abs(resid) <= bound), float(np.max(np.abs(resid) / bound))
+    friction = step * float(np.sum(np.abs(res["RotorTouchdown.T_f"][1:])))
+    assert friction > 3.0 * abs(float(np.sum(resid)))
 
 
 def first_impact_reference(res: dict[str, np.ndarray], step: float, g: float = 9.81
                            ) -> tuple[float, float]:
     """First impact after the failure from the state recorded at t = T_FAIL, by the
-    core's exact a = 0 flight (gravity + imbalance) with the recorded spin held per step.
-    Returns (time [s], rdot- [m/s])."""
+    spin core's closed-form a = 0 flight (gravity, imbalance, the recorded drive torque
+    held per step; the spin a state). Returns (time [s], rdot- [m/s])."""
     k = round(T_FAIL / step) - 1                  # row at t = T_FAIL
     assert res["time"][k] == pytest.approx(T_FAIL, abs=1e-12)
     r = "RotorTouchdown."
     z0 = complex(res[r + "x"][k], res[r + "y"][k])
     v0 = complex(res[r + "vx"][k], res[r + "vy"][k])
-    core = rotortd.TouchdownCore(rotortd.RotorParams(g=g), z0=z0, v0=v0,
-                                 psi0=float(res[r + "psi"][k]), t0=T_FAIL)
-    omegas = res["Drivetrain.Omega"]
-    for j in range(k, len(omegas) - 1):
-        rep = core.step(step, float(omegas[j]), amb_on=0.0)
+    core = rotortd.SpinCore(rotortd.RotorParams(g=g), J, z0=z0, v0=v0,
+                            psi0=float(res[r + "psi"][k]), Omega0=float(res[OMEGA][k]),
+                            t0=T_FAIL)
+    torques = res["Drivetrain.T_drive"]
+    for j in range(k, len(torques) - 1):
+        rep = core.step(step, F_ext=0j, amb_on=0.0, T_drive=float(torques[j]))
         if rep.impacts:
             imp = rep.impacts[0]
             return imp.t, imp.rdot
@@ -141,14 +211,31 @@ def test_drivetrain_pi_saturation_is_step_independent() -> None:
         assert other == pytest.approx(finals[0], rel=1e-10, abs=1e-10)
 
 
+def test_follow_speed_drive_torque_is_motor_plus_drag_at_the_held_speed() -> None:
+    """follow_speed (hold_speed): the drivetrain does not integrate its J; the PI acts on
+    the held Omega_in and T_drive = T_motor + T_drag = PI output - b Omega_in, averaged over
+    the step (the bearing's J is then the whole spinning inertia)."""
+    p = DriveParams(motor=MOTOR_PI, b=0.01, Kp=0.2, Ki=2.0, T_max=50.0)
+    core = DriveCore(p, 180.0, I0=0.5)
+    h, w_set = 1e-3, 184.2
+    rep = core.step(h, 0.0, 0.0, w_set, hold_speed=True)
+    e = w_set - 180.0
+    assert core.Omega == 180.0
+    assert rep.T_motor == pytest.approx(p.Kp * e + p.Ki * (0.5 + 0.5 * e * h), rel=1e-12)
+    assert rep.T_drag == pytest.approx(-p.b * 180.0, rel=1e-12)
+    i_end = core.I
+    assert i_end == pytest.approx(0.5 + e * h, rel=1e-12)
+
+
 # ---------------------------------------------------------------------------- scene 1: drop
 DROP_STOP = 0.14
 
 
-@pytest.mark.parametrize("engine", ["fmpy", "libcosim", "ecospy"])
+@pytest.mark.parametrize("engine", ENGINES)
 def test_drop_scene_physics(systems: Path, engine: str) -> None:
-    """Failure at 0.1 s: first impact = exact a = 0 flight from the state at failure;
-    momentum balance closes; the impacts spin the drivetrain down."""
+    """Failure at 0.1 s: first impact = exact a = 0 flight from the state at failure; the
+    coupling is exact (Omega_in = previous Omega_out, T_drive = T_motor + T_drag); the
+    spin's balance closes up to the imbalance's reaction; the impacts spin the rotor down."""
     h = DROP.step
     res = run_engine(systems, engine, "drop", stop=DROP_STOP)
     _check_reached(res, DROP_STOP, h)
@@ -157,18 +244,21 @@ def test_drop_scene_physics(systems: Path, engine: str) -> None:
     assert t_eng > T_FAIL
     assert t_eng == pytest.approx(t_ref, abs=1e-9)
     assert v_eng == pytest.approx(v_ref, rel=1e-6)
-    a, b = momentum_residuals(res, h, DROP.drive["Omega0"])
-    assert abs(a) < 1e-11 and abs(b) < 1e-11
-    assert res["Drivetrain.Omega"][-1] < DROP.drive["Omega0"] - 1.0
+    a, b = coupling_residuals(res, engine == "fmpy")
+    assert a == 0.0 and b < 1e-12
+    check_spin_balance(res, h, DROP.rotor)
+    assert res[OMEGA][-1] < DROP.rotor["Omega"] - 1.0
 
 
 def test_drop_engines_agree(systems: Path) -> None:
-    """libcosim and ecospy agree to round-off; FMPy differs from its first step (connected
-    inputs start at 0: Omega = amb_on = 0 for 0.1 ms) by a small, measured amount."""
+    """libcosim and ecospy agree to round-off (libcosim's integer-nanosecond clock passes
+    steps an ulp off h now and then); FMPy differs from its first step (connected inputs
+    start at 0: amb_on = T_drive = 0, and the drivetrain sees Omega_in = 0) by a small,
+    measured amount."""
     lc = run_engine(systems, "libcosim", "drop", stop=DROP_STOP)
     ec = run_engine(systems, "ecospy", "drop", stop=DROP_STOP)
     fm = run_engine(systems, "fmpy", "drop", stop=DROP_STOP)
-    for col in ("Drivetrain.Omega", "RotorTouchdown.x", "RotorTouchdown.T_f"):
+    for col in (OMEGA, "RotorTouchdown.x", "RotorTouchdown.T_f"):
         scale = max(1.0, float(np.max(np.abs(lc[col]))))
         assert np.max(np.abs(lc[col] - ec[col])) <= 1e-9 * scale, col
     k = round(T_FAIL / DROP.step) - 1
@@ -179,32 +269,66 @@ def test_drop_engines_agree(systems: Path) -> None:
     assert engine_first_impact(fm)[0] == pytest.approx(engine_first_impact(lc)[0], abs=2e-4)
 
 
+def test_in_process_master_is_the_engines(systems: Path) -> None:
+    """rotortd_cosim.coupling.spin_jacobi (SpinCore + DriveCore with the Jacobi semantics)
+    reproduces ecospy's drop scene with the PI drive bit for bit through the impacts and
+    the dry whip, so the step studies run in process."""
+    from rotortd_cosim.coupling import spin_jacobi
+
+    ec = run_engine(systems, "ecospy", "drop")
+    tr = spin_jacobi(DROP, DROP.step)
+    assert np.array_equal(np.asarray(tr.Omega), ec[OMEGA])
+    assert np.array_equal(np.asarray(tr.T_drive), ec["Drivetrain.T_drive"])
+    assert np.array_equal(np.asarray(tr.mode, float), ec["RotorTouchdown.mode"])
+    assert tr.mode[-1] == rotortd.MODE_ROLLING                     # dry whip at the end
+
+
+# ---------------------------------------------------------------------------- passive drive
+@pytest.mark.parametrize("engine", ENGINES)
+def test_constant_torque_coupling_equals_bearing_alone(systems: Path, engine: str) -> None:
+    """Torque motor without drag (motor = 0, b = 0, T_motor_in = 2 N m): T_drive does not
+    depend on the spin, so the coupled drop into dry whip equals the RotorTouchdown FMU
+    run alone with the inputs it held (T_drive = 0 in the first step, before any drivetrain
+    step, then 2 N m; amb_on from the events; on FMPy all 0 in the first step), at every
+    communication point, to 1e-10 (measured: bit for bit on every engine)."""
+    h = DROP_TORQUE.step
+    res = run_engine(systems, engine, "drop_torque")
+    _check_reached(res, DROP_TORQUE.stop_time, h)
+    assert np.all(res["Drivetrain.T_drive"] == DROP_TORQUE.drive["T_motor_in"])
+    alone = run_alone(systems, engine, "drop_torque", res, h)
+    assert np.array_equal(alone["time"], res["time"]) or np.allclose(
+        alone["time"], res["time"], rtol=0, atol=1e-12)
+    for col in alone:
+        if col == "time":
+            continue
+        scale = max(1.0, float(np.max(np.abs(res[col]))))
+        assert np.max(np.abs(alone[col] - res[col])) <= 1e-10 * scale, col
+    assert res["RotorTouchdown.mode"][-1] == rotortd.MODE_ROLLING  # through the dry whip
+    assert res["RotorTouchdown.n_impacts"][-1] > 100
+
+
 # ---------------------------------------------------------------------------- scene 2: rundown
 @pytest.mark.parametrize("engine", ["fmpy", "libcosim"])
-def test_rundown_impacts_appear_and_vanish(systems: Path, engine: str) -> None:
-    """Coasting from 220 rad/s through 140 rad/s: impacts (and rub) appear near the
-    critical speed and vanish below it; the spin-down rate is (T_f - b Omega)/J in every
-    mode, in particular while sliding."""
+def test_rundown_impacts_then_rub(systems: Path, engine: str) -> None:
+    """Coasting from 220 rad/s through 140 rad/s: impacts appear near 174 rad/s and give
+    way to a forward rub (sliding) that brakes the spin; the spin-down is the rigid body's
+    J dOmega/dt = T_drive + T_f (+ the imbalance's reaction, bounded) in every step, with
+    T_drive = -b Omega_in from the drivetrain."""
     h, stop = RUNDOWN.step, RUNDOWN.stop_time
     res = run_engine(systems, engine, "rundown")
     _check_reached(res, stop, h)
-    om, n = res["Drivetrain.Omega"], res["RotorTouchdown.n_impacts"]
-    mode, tf = res["RotorTouchdown.mode"], res["RotorTouchdown.T_f"]
+    om, n = res[OMEGA], res["RotorTouchdown.n_impacts"]
+    mode = res["RotorTouchdown.mode"]
     hit = np.nonzero(np.diff(n) > 0)[0] + 1
     assert len(hit) > 5
-    assert om[hit[0]] > 140.0 and om[hit[-1]] < 200.0
-    assert n[-1] == n[int(0.8 * len(n))] and mode[-1] == 0     # gone at the end
-    assert np.any(mode == 1)                                   # rub in between
-    # spin-down rate: J dOmega/dt = T_f(previous step) + T_drag, exact per step
-    dw = np.diff(om) / h
-    b = RUNDOWN.drive["b"]
-    drag = -b * 0.5 * (om[1:] + om[:-1])                      # mean of a near-linear decay
-    pred = (tf[:-1] + drag) / J
-    sliding = mode[1:] == 1
-    assert np.count_nonzero(sliding) > 100
-    assert np.max(np.abs(dw[sliding] - pred[sliding])) < 1e-4 * np.max(np.abs(pred))
-    a, c = momentum_residuals(res, h, RUNDOWN.drive["Omega0"])
-    assert abs(a) < 1e-10 and abs(c) < 1e-10
+    assert 140.0 < om[hit[0]] < 200.0 and om[hit[-1]] > 140.0
+    assert n[-1] == n[round(0.25 / h)] and mode[-1] == 1       # rubbing at the end
+    assert np.count_nonzero(mode[1:] == 1) > 1000
+    a, b = coupling_residuals(res, engine == "fmpy")
+    assert a == 0.0 and b < 1e-12
+    drag = res["Drivetrain.T_drive"][1:] + RUNDOWN.drive["b"] * res["Drivetrain.Omega"][1:]
+    assert np.max(np.abs(drag)) < 1e-12                         # motor off: T_drive = -b Omega
+    check_spin_balance(res, h, RUNDOWN.rotor)
 
 
 # ---------------------------------------------------------------------------- scene 3: force
@@ -223,11 +347,13 @@ def test_force_step_pushes_into_bearing_and_releases(systems: Path, engine: str)
     assert n[during][-1] > 0 or np.any(fn[during] > 0)
     after = t > 0.33
     assert np.all(np.diff(n[after]) == 0) and np.all(res["RotorTouchdown.mode"][after] == 0)
-    om = res["Drivetrain.Omega"]
-    assert om[during].min() < FORCE.drive["Omega0"] - 0.5
-    assert abs(om[-1] - FORCE.drive["Omega0"]) < abs(om[during].min() - FORCE.drive["Omega0"])
-    a, c = momentum_residuals(res, h, FORCE.drive["Omega0"])
-    assert abs(a) < 1e-10 and abs(c) < 1e-10
+    om = res[OMEGA]
+    w0 = FORCE.rotor["Omega"]
+    assert om[during].min() < w0 - 0.5
+    assert abs(om[-1] - w0) < abs(om[during].min() - w0)
+    a, b = coupling_residuals(res, engine == "fmpy")
+    assert a == 0.0 and b < 1e-12
+    check_spin_balance(res, h, FORCE.rotor)
 
 
 # ---------------------------------------------------------------------------- slow group
@@ -241,23 +367,83 @@ def test_ecos_cli_matches_libcosim(systems: Path) -> None:
     lc = run_engine(systems, "libcosim", "drop", stop=DROP_STOP)
     _check_reached(ec, DROP_STOP, DROP.step)
     assert np.array_equal(ec["RotorTouchdown.n_impacts"], lc["RotorTouchdown.n_impacts"])
-    for col in ("Drivetrain.Omega", "RotorTouchdown.r_rel"):
+    for col in (OMEGA, "RotorTouchdown.r_rel"):
         assert np.max(np.abs(ec[col] - lc[col]) / np.maximum(1.0, np.abs(lc[col]))) < 1e-5
 
 
 @pytest.mark.slow
-def test_integrate_spin_momentum_exact(systems: Path) -> None:
-    """Bearing alone with integrate_spin, AMB off from the start under gravity (falls,
-    impacts, dry whip): J (Omega_out - Omega0) = sum of h (T_drive + T_f) to round-off."""
+def test_ecos_cli_constant_torque_equals_bearing_alone(systems: Path) -> None:
+    """The passive-drive equality on the native ecos CLI, to its CSV's ~6 digits (the run
+    alone gets the inputs ecospy's clock gives: the CLI's own are only in the CSV)."""
+    if importlib.util.find_spec("ecospy") is None:
+        pytest.skip("ecospy is not installed")
+    h = DROP_TORQUE.step
+    ec = run_engine(systems, "ecos", "drop_torque")
+    _check_reached(ec, DROP_TORQUE.stop_time, h)
+    full = run_engine(systems, "ecospy", "drop_torque")
+    alone = run_alone(systems, "ecospy", "drop_torque", full, h)
+    assert np.array_equal(ec["RotorTouchdown.n_impacts"], alone["RotorTouchdown.n_impacts"])
+    for col in (OMEGA, "RotorTouchdown.r_rel"):  # (x, y: 6 decimals, 1e-6 m, in the CSV)
+        scale = np.maximum(1.0, np.abs(alone[col]))
+        assert np.max(np.abs(ec[col] - alone[col]) / scale) < 1e-5, col
+
+
+PI_STEPS = (4e-4, 2e-4, 1e-4, 5e-5)
+PI_LIMIT = {0.1: 183.96427410, 0.2: 168.35494329, 0.35: 63.12398411}
+"""Omega_out [rad/s] of the drop scene with the PI drive in the limit h -> 0: at 0.1 s (the
+failure; free whirl with the AMB on), 0.2 s (after 26 impacts) and 0.35 s (in dry whip,
+298 impacts), from the in-process master (rotortd_cosim.coupling.spin_jacobi) extrapolated
+as O(h): from h = 1e-5 and 5e-6 s at 0.1 s, from 5e-6 and 1e-6 s at 0.2 and 0.35 s
+(Omega(1e-6) = 168.35479758 and 63.12384373; the extrapolation moves them by 1.5e-4, the
+smallest error tested here is 3e-3; docs/cosimulation.md)."""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_pi_coupling_error_is_first_order(systems: Path, engine: str) -> None:
+    """With the PI drive the coupling is explicit in T_drive (held over a step, computed
+    from the Omega of the step before): the error against the small-step limit is O(h).
+    Fitted log-log slope of |Omega_out(t) - limit| over h = 4e-4 ... 5e-5 s within
+    [0.8, 1.2]: at 0.1 s on every engine; on libcosim and ecospy also at 0.2 s and in the
+    dry whip at 0.35 s, with the same 298 impacts at every step. FMPy's first step (every
+    connector at 0: amb_on = T_drive = 0 in the bearing, Omega_in = 0 in the drivetrain,
+    whose PI saturates) is an O(h) perturbation too, but the impacts after the failure
+    amplify it: 298 ... 318 impacts and no monotone error at these steps (measured at 0.2 s:
+    0.14, 0.56, 0.056, 0.047 rad/s), so FMPy is checked at the failure only."""
+    times = (0.1,) if engine == "fmpy" else tuple(PI_LIMIT)
+    errs: dict[float, list[float]] = {t: [] for t in times}
+    impacts = []
+    for h in PI_STEPS:
+        res = run_engine(systems, engine, "drop", step=h)
+        _check_reached(res, DROP.stop_time, h)
+        impacts.append(res["RotorTouchdown.n_impacts"][-1])
+        for t in times:
+            errs[t].append(abs(float(res[OMEGA][round(t / h) - 1]) - PI_LIMIT[t]))
+    assert engine == "fmpy" or set(impacts) == {298}
+    for t, e in errs.items():
+        slope = np.polyfit(np.log(PI_STEPS), np.log(e), 1)[0]
+        assert 0.8 <= slope <= 1.2, (engine, t, e, slope)
+        assert e[-1] < 0.1
+
+
+@pytest.mark.slow
+def test_spin_balance_exact_without_imbalance(systems: Path) -> None:
+    """Bearing alone with integrate_spin, e_c = 0 (no imbalance reaction), AMB off from the
+    start under gravity (falls, 14 impacts with d = 0.3, then contact), T_drive = 2 N m:
+    the rigid body's spin
+    balance J (Omega_out - Omega0) = sum of h (T_drive + T_f) holds to round-off (the
+    contact impulses are the core's error-controlled quadratures)."""
     code = (
         "import json, math, numpy as np\n"
         "from fmpy import simulate_fmu\n"
-        f"r = simulate_fmu(r'{systems.parent / 'RotorTouchdown.fmu'}', stop_time=0.03,\n"
-        "    output_interval=1e-4, start_values={'g': 9.81, 'amb_on': 0.0,\n"
-        "    'integrate_spin': True, 'J': 0.04, 'h_spin': 1e-5, 'T_drive': 2.0},\n"
-        "    output=['Omega_out', 'T_f', 'mode'])\n"
+        f"r = simulate_fmu(r'{systems.parent / 'RotorTouchdown.fmu'}', stop_time=0.05,\n"
+        "    output_interval=1e-4, start_values={'g': 9.81, 'amb_on': 0.0, 'e_c': 0.0, 'd': 0.3,\n"
+        "    'integrate_spin': True, 'J': 0.04, 'T_drive': 2.0},\n"
+        "    output=['Omega_out', 'T_f', 'mode', 'n_impacts'])\n"
         "res = 0.04 * (r['Omega_out'][-1] - 184.2) - 1e-4 * math.fsum(2.0 + r['T_f'][1:])\n"
-        "print('RES', json.dumps([res, float(r['time'][-1]), float(r['Omega_out'][-1])]))\n"
+        "h_f = 1e-4 * math.fsum(abs(r['T_f'][1:]))\n"
+        "print('RES', json.dumps([res, h_f, float(r['time'][-1]), float(r['Omega_out'][-1]),\n"
+        "    int(r['n_impacts'][-1]), int(np.count_nonzero(r['mode']))]))\n"
         "import os; os._exit(0)\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=600, env=_env())
@@ -265,10 +451,27 @@ def test_integrate_spin_momentum_exact(systems: Path) -> None:
     assert line, proc.stdout[-2000:] + proc.stderr[-2000:]
     import json
 
-    res, t_end, om = json.loads(line[0][3:])
-    assert t_end == pytest.approx(0.03)
-    assert abs(res) < 1e-11
+    res, h_f, t_end, om, n_imp, n_contact = json.loads(line[0][3:])
+    assert t_end == pytest.approx(0.05)
+    assert n_imp > 0 and n_contact > 0 and h_f > 0.1
+    assert abs(res) < 1e-11 * max(1.0, h_f)
     assert om < 184.2
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="core bug: SpinCore makes no progress after the "
+                   "lift-off from the rub (zero-length flights), docs/cosimulation.md")
+def test_rundown_lift_off_step_completes() -> None:
+    """The run-down coupled in process (as ecospy) reaches its lift-off from the rub at
+    0.3611 s; that step of the bearing stalls at the work bound (every engine: FMPy and
+    ecospy Discard, libcosim would go on with frozen outputs), hence RUNDOWN.stop_time =
+    0.36 s. Passes once the core is fixed: then restore the run-down to 0.6 s."""
+    from dataclasses import replace
+
+    from rotortd_cosim.coupling import spin_jacobi
+
+    tr = spin_jacobi(replace(RUNDOWN, stop_time=0.3615), RUNDOWN.step)
+    assert tr.time[-1] == pytest.approx(0.3615)
 
 
 def _drivetrain_slave(**params: float) -> object:

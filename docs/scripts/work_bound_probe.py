@@ -3,7 +3,8 @@
 Draws parameters, initial states, inputs and step sizes over the ranges the FMU accepts
 (log-uniform over positive ranges, with the ends and zero included), runs each scene on
 the core directly, the way rotortd_fmi/touchdown.py calls it (``TouchdownCore.step``, or
-``SpinCoupler.step`` with ``integrate_spin``), each scene in a subprocess with a time
+``SpinCore.step`` with ``integrate_spin``: the spin a state, J drawn over its range, the
+drive torque held), each scene in a subprocess with a time
 limit, and records per step: wall time, work units, status. Prints the slowest steps, the
 largest work of a completed step and the worst time per work unit.
 
@@ -65,7 +66,8 @@ def sample(case: int) -> dict:
         "psi0": rng.uniform(-1e4, 1e4) if rng.random() < 0.2 else 0.0,
         "spin": rng.random() < 0.3,
         "J": _pick(rng, [1e-9, 1e7], 1e-9, 1e7),
-        "h_spin": _pick(rng, [1e-8, 1.0], 1e-8, 1.0),
+        "h_spin": _pick(rng, [1e-8, 1.0], 1e-8, 1.0),  # unused (deprecated); kept so that
+        # the draws, hence the scenes of every case number, stay those of earlier runs
         "h": _pick(rng, [1e-12, 10.0, 1e-4, 1e-3], 1e-12, 10.0, 0.3),
         "n_steps": rng.choice([3, 10, 30]),
         "inputs": [],
@@ -82,25 +84,30 @@ def sample(case: int) -> dict:
 
 def run_scene(scene: dict, t_limit: float, verbose: bool = False) -> dict:
     """Run one scene; per step (h, wall s, work, status, message)."""
-    from rotortd import RotorParams, TouchdownCore
-    from rotortd_drive import SpinCoupler
+    from rotortd import CrossParameterError, RotorParams, SpinCore, TouchdownCore
 
     p = RotorParams(**scene["params"])
-    core = TouchdownCore(p, complex(*scene["z0"]), complex(*scene["v0"]), scene["psi0"])
     ins = scene["inputs"]
-    spin = SpinCoupler(scene["J"], scene["h_spin"], ins[0]["Omega"]) if scene["spin"] else None
+    z0, v0 = complex(*scene["z0"]), complex(*scene["v0"])
+    spin = scene["spin"]
+    if spin:
+        try:
+            core = SpinCore(p, scene["J"], z0, v0, scene["psi0"], Omega0=ins[0]["Omega"])
+        except CrossParameterError as exc:  # J too small for well-posed contact: refused
+            return {"steps": [], "refused": str(exc)[:300]}
+    else:
+        core = TouchdownCore(p, z0, v0, scene["psi0"])
     steps = []
     total = 0.0
     for i in range(scene["n_steps"]):
         inp = ins[min(i * len(ins) // scene["n_steps"], len(ins) - 1)]
         F = complex(*inp["F"])
         t = time.process_time()
-        if spin is not None:
-            rep = spin.step(core, scene["h"], inp["T_drive"], F_ext=F, amb_on=inp["amb_on"])
-            work = getattr(rep, "work", -1)
+        if spin:
+            rep = core.step(scene["h"], F_ext=F, amb_on=inp["amb_on"], T_drive=inp["T_drive"])
         else:
             rep = core.step(scene["h"], inp["Omega"], F_ext=F, amb_on=inp["amb_on"])
-            work = rep.work
+        work = rep.work
         dt = time.process_time() - t
         total += dt
         steps.append([dt, work, rep.status, rep.message[:300]])

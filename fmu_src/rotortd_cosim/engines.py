@@ -12,7 +12,12 @@ Engine differences handled here (see docs/cosimulation.md):
   step's START time although the values are those after the step: shifted here by +h.
   Its connectors all start at 0.0, so in the first step the bearing sees Omega = 0,
   amb_on = 0, F = 0 whatever the upstream outputs are.
-- libcosim counts time in integer nanoseconds: the step is passed as round(h * 1e9).
+- libcosim counts time in integer nanoseconds: the step is passed as round(h * 1e9), and
+  each doStep gets the difference of two time points converted to seconds (an ulp off h
+  now and then: rotortd_cosim.alone._clock). Its step call returns False after a
+  component's fmi2Discard, and the execution would go on with frozen outputs: refused.
+  ecospy goes on after a Discard too, printing the error, and its step returns only the
+  time: the runner cannot refuse it.
 - ecos: the bundled binaries need chmod +x; the native CLI needs LD_PRELOAD of libpython.
   Both ecospy and the CLI need libtbb.so.12: from the environment's ``tbb`` package,
   loaded by :func:`.tbb.load_libtbb` before ecospy is imported, and put on
@@ -33,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from .scenes import RECORDED, SCENES, Scene
+from .scenes import ALL_SCENES, RECORDED, Scene
 from .tbb import load_libtbb
 
 Result = dict[str, np.ndarray]
@@ -89,7 +94,9 @@ def run_libcosim(ssp: Path, scene: Scene, step: float, stop: float | None = None
     index, refs = _libcosim_refs(ex)
     rows: dict[str, list[float]] = {c: [] for c in ["time", *COLUMNS]}
     for k in range(n):
-        ex.step(1)
+        if not ex.step(1):  # a component's fmi2Discard; libcosim would go on silently
+            raise RuntimeError(f"libcosim: step {k} at t = {k * step_ns * 1e-9!r} s failed "
+                               f"(a component returned fmi2Discard or worse)")
         rows["time"].append((k + 1) * step_ns * 1e-9)
         for col in COLUMNS:
             comp, _var = col.split(".")
@@ -217,5 +224,5 @@ ENGINES = {"fmpy": run_fmpy_ssp, "libcosim": run_libcosim, "ecospy": run_ecospy,
 def run(engine: str, scene: str, ssp: Path, step: float | None = None,
         stop: float | None = None) -> Result:
     """Run a scene on an engine."""
-    sc = SCENES[scene]
+    sc = ALL_SCENES[scene]
     return ENGINES[engine](ssp, sc, sc.step if step is None else step, stop)

@@ -129,9 +129,11 @@ def write_ssp(scene: Scene, models: Path, out_dir: Path) -> Path:
     return path
 
 
-def write_all(models: Path, out_dir: Path) -> list[Path]:
-    """All scenes' SSP files."""
-    return [write_ssp(s, models, out_dir) for s in SCENES.values()]
+def write_all(models: Path, out_dir: Path, scenes: dict[str, Scene] | None = None
+              ) -> list[Path]:
+    """The SSP files of ``scenes`` (default: the documented scenes, SCENES)."""
+    return [write_ssp(s, models, out_dir) for s in (SCENES if scenes is None else
+                                                    scenes).values()]
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,4 +1,4 @@
-"""rotortd_drive: drivetrain and spin-coupling helpers for the rotor-touchdown FMUs.
+"""rotortd_drive: the drivetrain of the rotor-touchdown FMUs.
 
 Pure Python (``math`` only), shipped inside the FMUs as ``resources/rotortd_drive``; the
 name is unique to this project because every PythonFMU instance in a process shares
@@ -6,9 +6,10 @@ name is unique to this project because every PythonFMU instance in a process sha
 
 - :class:`DriveParams`, :class:`DriveCore`: ``J Omega' = T_motor - b Omega + T_bearing``
   with the motor a held torque input or a PI speed controller with a torque limit, advanced
-  exactly for inputs held over a step (piecewise closed form).
-- :class:`SpinCoupler`: integrates the spin inside the bearing FMU by sub-stepping the
-  touchdown core and applying the exact friction impulse of each sub-step.
+  exactly for inputs held over a step (piecewise closed form). With ``hold_speed`` (the
+  Drivetrain FMU's ``follow_speed``) the spin is held at a speed read from outside (the
+  bearing's spin state, ``rotortd.SpinCore``) and the step returns the motor and drag
+  torques for it.
 """
 
 from .drive import (
@@ -20,7 +21,6 @@ from .drive import (
     DriveReport,
     held_speed_report,
 )
-from .spin import SpinCoupler, SpinReport
 
 __all__ = [
     "MOTOR_PI",
@@ -29,7 +29,5 @@ __all__ = [
     "DriveError",
     "DriveParams",
     "DriveReport",
-    "SpinCoupler",
-    "SpinReport",
     "held_speed_report",
 ]

@@ -7,10 +7,13 @@ The motor is a held torque input (``motor = 0``) or a PI speed controller with s
 pure-Python package ``rotortd_drive`` (shipped as ``resources/rotortd_drive``), which
 advances the drivetrain exactly for inputs held over a communication step.
 
-Connect ``Omega`` to ``RotorTouchdown.Omega`` and ``RotorTouchdown.T_f`` to ``T_bearing``.
-With ``follow_speed`` the drivetrain does not integrate its inertia: ``Omega`` follows the
-input ``Omega_in`` (e.g. ``RotorTouchdown.Omega_out`` with ``integrate_spin``) and
-``T_drive`` (motor plus drag, step-averaged) goes to ``RotorTouchdown.T_drive``.
+The recommended coupling (docs/cosimulation.md, the project's scenes) lets the bearing own
+the spin: ``follow_speed = true``, ``RotorTouchdown.Omega_out`` to ``Omega_in`` and
+``T_drive`` (motor plus drag at the held ``Omega_in``, step-averaged) to
+``RotorTouchdown.T_drive``, with ``RotorTouchdown.integrate_spin`` and its ``J`` the whole
+spinning inertia; this drivetrain's ``J`` is then unused. For a drivetrain that owns the
+inertia (held-speed coupling, unstable in rolling for J < m R^2): ``Omega`` to
+``RotorTouchdown.Omega`` and ``RotorTouchdown.T_f`` to ``T_bearing``.
 
 Cumulative angular impulses ``H_motor``, ``H_drag``, ``H_bearing`` [N m s] close the
 momentum balance ``J (Omega - Omega0) = H_motor + H_drag + H_bearing`` to round-off.
