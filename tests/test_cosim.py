@@ -7,9 +7,9 @@ subprocess (``python -m rotortd_cosim.run``): PythonFMU FMUs share the host's in
 can crash it at exit. Quick group: FMPy's SSP master, libcosimpy and ecospy on the three
 scenes, the passive-drive equality with the bearing run alone on each, the in-process master
 against ecospy; slow group: the native ecos CLI, the first-order coupling error with the PI
-drive on each engine, the exact spin balance with e_c = 0, the core stall at the run-down's
-lift-off (strict xfail). ecospy and the CLI need libtbb.so.12, from the tbb package of the
-test extra (rotortd_cosim.tbb loads it in the engine's process).
+drive on each engine, the exact spin balance with e_c = 0, the run-down's lift-off step.
+ecospy and the CLI need libtbb.so.12, from the tbb package of the test extra
+(rotortd_cosim.tbb loads it in the engine's process).
 """
 
 from __future__ import annotations
@@ -459,13 +459,10 @@ def test_spin_balance_exact_without_imbalance(systems: Path) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="core bug: SpinCore makes no progress after the "
-                   "lift-off from the rub (zero-length flights), docs/cosimulation.md")
 def test_rundown_lift_off_step_completes() -> None:
-    """The run-down coupled in process (as ecospy) reaches its lift-off from the rub at
-    0.3611 s; that step of the bearing stalls at the work bound (every engine: FMPy and
-    ecospy Discard, libcosim would go on with frozen outputs), hence RUNDOWN.stop_time =
-    0.36 s. Passes once the core is fixed: then restore the run-down to 0.6 s."""
+    """The run-down coupled in process (as ecospy) through its lift-off from the rub at
+    0.3611 s: that step of the bearing completes (the flight after a lift-off once found the
+    wall again at once, in zero-length flights until the work bound)."""
     from dataclasses import replace
 
     from rotortd_cosim.coupling import spin_jacobi

@@ -118,9 +118,6 @@ def test_spin_core_default_budget_is_the_core_bound() -> None:
     assert core.step(1e-4, budget=10 * WORK_MAX).work_cap == WORK_MAX
 
 
-@pytest.mark.xfail(strict=True, reason="core bug: a SpinCore flight that starts on the wall "
-                   "with no outward speed finds the wall again at once (zero-length flights "
-                   "until the work bound); TouchdownCore steps it")
 def test_spin_core_leaves_the_wall_inward() -> None:
     """On the wall with a tangential velocity, the AMB pulling inward: the rotor must
     leave the wall (TouchdownCore does, in one OK step)."""

@@ -60,7 +60,7 @@ MAX_ADVANCES = 400
 wall for long may need more, and the caller then resumes from where the search stopped."""
 WORK_MAX = 1_600_000
 """Work bound of one communication step, in work units (``Work``; docs/model.md 7): a
-step, with all of its spin sub-steps, that would need more stops with STATUS_WORK_CAP.
+step that would need more stops with STATUS_WORK_CAP (TouchdownCore and SpinCore alike).
 Every loop of the core counts into one counter; it is checked before each segment, at
 each advance of the contact search and at each step of the sliding integrator."""
 WORK_OVERSHOOT = 14_100

@@ -260,9 +260,9 @@ class TouchdownCore(FlightSteps, ContactSteps):
              budget: int | None = None) -> StepReport:
         """Advance by h seconds with Omega (rad/s), F_ext (N) and amb_on held.
 
-        The step's work is bounded by ``budget`` work units (default and at most WORK_MAX;
-        SpinCoupler passes what its sub-steps have left). A step that would need more stops
-        where it is with STATUS_WORK_CAP and a message saying where (docs/model.md 7)."""
+        The step's work is bounded by ``budget`` work units (default and at most WORK_MAX).
+        A step that would need more stops where it is with STATUS_WORK_CAP and a message
+        saying where (docs/model.md 7)."""
         F = complex(F_ext)
         if not (0.0 < h < math.inf and math.isfinite(Omega) and 0.0 <= amb_on <= 1.0
                 and math.isfinite(F.real) and math.isfinite(F.imag)):

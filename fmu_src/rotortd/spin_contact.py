@@ -43,10 +43,16 @@ RTOL = 1e-13
 """Relative tolerance per extrapolated step, every component."""
 H_FRACTION = 1.0
 """Largest step, in radians of the fastest rotation of the contact (theta', Omega, beta')."""
-STEP_WORK = 8
-"""Work units per extrapolated step beyond its right-hand sides (as sliding.GBS_STEP_WORK)."""
-ROOT_ITERS = 80
-"""Most regula-falsi iterations of an event location."""
+RHS_WORK = 2
+"""Work units per right-hand side: one costs about twice the held core's sliding one
+(measured 2.2 us per unit in rolling at one unit each; docs/model.md 7)."""
+STEP_WORK = 16
+"""Work units per extrapolated step beyond its right-hand sides (twice
+sliding.GBS_STEP_WORK, as RHS_WORK)."""
+ROOT_ITERS = 60
+"""Most regula-falsi iterations of an event location (Illinois; bisection where it stalls
+reaches 4 ulp in at most 53). With at most 9 columns, 18 + ... + 2 = 90 right-hand sides,
+an event location costs at most 60 (2 * 90 + 16) = 11,760 units, inside events.WORK_OVERSHOOT."""
 
 Vector = list[float]
 
@@ -238,12 +244,12 @@ class SpinContact:
             scale = self.tol_state + [t * Hs + RTOL * abs(q)
                                       for t, q in zip(self.tol_rate, y[nq:])]
             y1, err, k, nfev = gbs.extrapolated_step(sweep, u, y, f0, Hs, scale, k_min=4)
-            work += nfev + STEP_WORK
+            work += RHS_WORK * nfev + STEP_WORK
             if not err <= 1.0:
                 H = 0.25 * Hs if err != err else gbs.next_step_size(Hs, err, k)
                 continue
             f1 = self.rhs(u + Hs, y1)
-            work += 2
+            work += 2 * RHS_WORK
             hit = self._event_in_step(sweep, u, y, f0, y1, f1, Hs, k, scale)
             if hit is not None:
                 tau, y, w2 = hit
@@ -284,7 +290,7 @@ class SpinContact:
         def at(tau: float) -> tuple[Vector, float]:
             nonlocal work
             yt, _, _, nfev = gbs.extrapolated_step(sweep, u, y, f0, tau, scale, k_fixed=k)
-            work += nfev + STEP_WORK
+            work += RHS_WORK * nfev + STEP_WORK
             return yt, self._margin(yt)
 
         a, fa = 0.0, self._margin(y)

@@ -48,7 +48,7 @@ DROP = Scene(
 
 RUNDOWN = Scene(
     name="rundown", title="Run-down through the critical speed sqrt(k/m) = 140 rad/s",
-    stop_time=0.36, step=1e-4,
+    stop_time=0.6, step=1e-4,
     rotor={"g": 9.81, "levitate": True, "start_steady": True, "Omega": 220.0, **SPIN},
     drive={**FOLLOW, "b": 0.06, "motor": 0, "Omega0": 220.0, "T_motor_in": 0.0},
     events={},
