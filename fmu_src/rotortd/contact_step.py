@@ -105,6 +105,7 @@ class ContactSteps:
         ``rep``) and its event (``st`` may be None only for an end without event)."""
         p = self._p
         rep.add_contact(end.tally, p.m * p.c_r, p.c_r)
+        self._imb_add(rep, self._phasor(), p.c_r * end.tally.I_z)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_psi(end.duration)
         self._transition(end.event, st)
@@ -120,9 +121,11 @@ class ContactSteps:
         rub = self._rub_choice(self._phasor(), True)
         if rub is None:
             return False
+        start = self._imb_state()  # (after a lock: its snap is not an impulse)
         end = rub.run(h)
         rep.work = end.tally.work
         self._end_segment(end, rep, None)
+        self._imb_close(rep, start, h)
         return True
 
     def _leaves_wall(self, E: complex) -> bool:

@@ -65,7 +65,11 @@ class FlightSteps:
                 work += 1
                 if not flight_is_clear(fm, self._z, self._v, E, h):
                     return False
-        self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
+        z0, v0 = self._z, self._v
+        self._z, self._v = fm.propagate(z0, v0, E, h, cache=True)
+        imb = fm.imb_impulse(h)  # the imbalance reaction's impulse, closed form (cached)
+        rep.P_imb = P = (E.conjugate() * (imb.bz * z0 + imb.bv * v0 + imb.b0) + imb.bE).imag
+        rep.T_imb = P / h
         self._advance_psi(h)
         self._on_wall = False
         rep.work = work
@@ -96,6 +100,7 @@ class FlightSteps:
             loc = ContactLocator(fm, self._z, self._v, E)
             hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
         if hit is None:
+            self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, rem))
             if loc is not None and s > 0.0:
                 # the rest of a step after an event: a length that will not recur, whose
                 # flight map costs twelve times the search's modal state (measured)
@@ -107,6 +112,7 @@ class FlightSteps:
             self._on_wall = False
             return h
         ds = min(hit.s, rem)
+        self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, ds))
         self._advance_psi(ds)
         if hit.kind == "clear":
             self._z, self._v = hit.z, hit.v

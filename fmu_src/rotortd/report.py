@@ -30,7 +30,10 @@ class StepReport:
     Also the step's accumulator: while the step runs, impacts and contact segments add
     their impulses to P_contact, P_n, P_t, E_diss and F_n_peak (the contact force's peak;
     the impacts' P_n/h join it at the end), and the step's end turns the impulses into the
-    averages F_contact, F_n and T_f (``TouchdownCore._finish``)."""
+    averages F_contact, F_n and T_f (``TouchdownCore._finish``). P_imb, the imbalance
+    reaction's angular impulse, is gathered as docs/model.md says (``TouchdownCore._imb_*``):
+    each segment adds its integral of the co-rotating position, the step's end adds the
+    boundary terms; T_imb = P_imb/h."""
 
     status: int = STATUS_OK
     message: str = ""
@@ -50,6 +53,14 @@ class StepReport:
     """Impulse of the contact on the rotor over the step (N s): F_contact = P_contact/h."""
     P_t: float = 0.0
     """Signed friction impulse (N s): T_f = -R P_t/h."""
+    P_imb: float = 0.0
+    """Angular impulse (N m s) of the imbalance reaction on the spin over the step, held
+    Omega: int e_c Im(conj(F_amb + F_ext + F_c) e^{i(psi + phi)}) dt, impacts as impulses
+    (F_amb = a (F_bias - c z' - k z); F_ext without gravity; F_c the contact force on the
+    rotor). T_imb = P_imb/h."""
+    T_imb: float = 0.0
+    """Imbalance reaction torque on the spin (N m), step average P_imb/h: a drivetrain that
+    owns the spin inertia integrates J Omega' = T_drive + T_f + T_imb."""
 
     def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
         """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""

@@ -234,6 +234,8 @@ class LinearRub(_RubStep):
         tal.I_c = -complex(1.0, mus) * cmath.exp(1j * (self.theta0 - x0)) * ring
         tal.I_e = mus * ((wf.wr + W) * tal.I_n + eq.Gn * int_y)
         tal.peak = eq.Gn + max(gx * x0 + gy * y0, gx * x1 + gy * y1)
+        # theta - Omega u = theta0 - x0 + x: e^{ix} to first order, as the force's direction
+        tal.I_z = cmath.exp(1j * (self.theta0 - x0)) * complex(rem, int_x)
         tal.work = 1
         return SegmentEnd(rem, self.theta0 + W * rem + dx, W + y1, None, tal)
 
@@ -353,6 +355,8 @@ class QuadraticRub(_RubStep):
         tal.I_e = mus * ((wf.wr + W) * tal.I_n + Gn * int_y + (gx * S2 + gy * S3).real)
         tal.peak = Gn + max(gx * x0 + gy * y0 + gxx * q0[0] + q0[2],
                             gx * x + gy * y + gxx * q[0] + q[2])
+        # e^{ix} to second order: int (1 + i x - x^2/2), int x^2 = S1 to that order
+        tal.I_z = cmath.exp(1j * (self.theta0 - x0)) * complex(rem - 0.5 * S1.real, int_x)
         tal.work = 1
         return SegmentEnd(rem, self.theta0 + W * rem + (x - x0), W + y, None, tal)
 
@@ -378,6 +382,7 @@ class LockedRub:
         tal.I_c = -complex(gn, ft) * cmath.exp(1j * theta) * phase_integral(wf.Omega, rem)
         tal.I_e = ft * (wf.wr + dtheta) * rem
         tal.peak = gn
+        tal.I_z = cmath.exp(1j * theta) * phase_integral(dtheta - wf.Omega, rem)
         tal.work = 1
         return SegmentEnd(rem, theta + wf.Omega * rem, dtheta, None, tal)
 

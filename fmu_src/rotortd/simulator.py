@@ -43,7 +43,7 @@ from .report import (
 from .rub import RubEquilibrium
 from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 from .state import CoreState
-from .wall import ContactWorkExceeded, WallForces
+from .wall import ContactWorkExceeded, WallForces, phase_integral
 
 __all__ = [
     "ETA_HEIGHT", "ETA_TIME", "LOCK_TOL", "MODE_FREE", "MODE_ROLLING", "MODE_SLIDING",
@@ -292,6 +292,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         end (``_advance``), until the step is done or its work bound is reached. Returns
         how far (s) into the step it got."""
         work, cap, s = st.work, st.cap, 0.0
+        start = self._imb_state()
         try:
             while s < h:
                 if work.total > cap:
@@ -311,6 +312,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
                 f"{len(rep.impacts)} impacts in the step): {exc}")
         rep.work = work.total
+        self._imb_close(rep, start, s)
         return s
 
     def _finish(self, rep: StepReport, t0: float, s: float, h: float, tallied: bool) -> None:
@@ -354,8 +356,48 @@ class TouchdownCore(FlightSteps, ContactSteps):
         for imp in rep.impacts:
             rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
         rep.T_f = -self._p.R * rep.P_t * inv
+        rep.T_imb = rep.P_imb * inv
         rep.mode = self._mode
         self._E_diss += rep.E_diss
+
+    # ------------------------------------------------------------------ imbalance torque
+    # P_imb = int e_c Im(conj(F_amb + F_ext + F_c) E) dt, E = e^{i(psi + phi)}, held Omega.
+    # The proved-free step takes it in closed form (FlightModel.imb_impulse); every other
+    # step by the identity m z'' = F_amb + F_ext + F_c + G + m e_c Omega^2 E (G gravity),
+    # integrated by parts (z' may jump: impacts are included as impulses):
+    #   P_imb = e_c m (Im[conj(z') E]_0^h - Omega Re[conj(z) E]_0^h
+    #                  - Omega^2 Im int conj(z) E dt) - e_c Im(conj(G) int E dt),
+    # with int conj(z) E dt = sum over the segments of e^{i phi} E_seg conj(K_seg),
+    # K_seg = int z e^{-i Omega u} du from the segment's start (_imb_add): closed form in
+    # flight, rolling and the rub, the error-controlled quadrature in sliding.
+
+    def _imb_state(self) -> tuple[complex, complex, complex]:
+        """(z (m), v (m/s), e^{i psi}) now: the boundary state of the imbalance identity."""
+        z, v = self._wall_state() if self._mode else (self._z, self._v)
+        return z, v, self._phasor()
+
+    def _imb_add(self, rep: StepReport, E: complex, K: complex) -> None:
+        """Add a segment's term -e_c m Omega^2 Im(e^{i phi} E conj(K)) (N m s) to P_imb: K =
+        int z e^{-i Omega u} du (m s) over the segment, E = e^{i psi} at its start."""
+        W = self._inputs[0]
+        if W != 0.0 and K != 0:
+            p = self._p
+            rot = cmath.exp(1j * p.phi) * E
+            rep.P_imb -= p.e_c * p.m * W * W * (rot * K.conjugate()).imag
+
+    def _imb_close(self, rep: StepReport, start: tuple[complex, complex, complex],
+                   dur: float) -> None:
+        """Add the identity's boundary and gravity terms (N m s) of a step that started in
+        ``start`` (``_imb_state``) and lasted dur seconds to P_imb."""
+        z0, v0, E0 = start
+        z1, v1, E1 = self._imb_state()
+        p, W = self._p, self._inputs[0]
+        eph = cmath.exp(1j * p.phi)
+        A0, A1 = eph * E0, eph * E1
+        bound = ((v1.conjugate() * A1 - v0.conjugate() * A0).imag
+                 - W * (z1.conjugate() * A1 - z0.conjugate() * A0).real)
+        grav = (p.gravity_force.conjugate() * A0 * phase_integral(W, dur)).imag
+        rep.P_imb += p.e_c * (p.m * bound - grav)
 
     def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
         """One segment from s seconds into the step: flight or contact, by the mode."""
