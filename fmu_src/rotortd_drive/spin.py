@@ -56,6 +56,9 @@ class SpinReport:
     P_n: float = 0.0
     T_f: float = 0.0
     E_diss: float = 0.0
+    T_imb: float = 0.0
+    """Imbalance reaction torque (N m), the sub-steps' T_imb averaged like T_f. Reported
+    only: the spin here integrates J Omega' = T_drive + T_f, as before."""
     mode: int = 0
     transitions: list[Any] = field(default_factory=list)
     Omega_end: float = 0.0     # rad/s
@@ -129,6 +132,7 @@ def _accumulate(out: SpinReport, rep: Any, hs: float) -> None:
     out.F_n_peak = max(out.F_n_peak, rep.F_n_peak)
     out.P_n += rep.P_n
     out.T_f += rep.T_f * hs
+    out.T_imb += rep.T_imb * hs
     out.E_diss += rep.E_diss
     out.mode = rep.mode
     out.transitions.extend(rep.transitions)
@@ -139,3 +143,4 @@ def _average(out: SpinReport, span: float) -> None:
     out.F_contact /= span
     out.F_n /= span
     out.T_f /= span
+    out.T_imb /= span
