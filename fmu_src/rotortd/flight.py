@@ -38,6 +38,10 @@ from typing import NamedTuple
 from .divdiff import dd2, dd3, dd4
 from .params import RotorParams
 
+IMB_COND = 1e-2
+"""imb_integral_ends solves for K from the flight's two ends only when |kappa - Omega^2 +
+i beta Omega| >= IMB_COND (kappa + Omega^2 + beta |Omega|) (rounding amplified at most
+100-fold); nearer resonance, or with kappa = Omega = 0, it uses the closed form."""
 MODAL_GAIN = 4.0
 """Largest ratio of the modal amplitudes to the state's scale for which the search
 evaluates the flight by modes (FlightModel.modes)."""
@@ -130,6 +134,12 @@ class FlightModel:
         sqrt(K/c_r), the rate at which the largest force crosses the clearance."""
         self._cache: dict[float, FlightCoeffs] = {}
         self._imb_cache: dict[float, ImbImpulse] = {}
+        W = self.Omega
+        self._imb_den = complex(self.kappa - W * W, self.beta * W)
+        """kappa - Omega^2 + i beta Omega (1/s^2): imb_integral_ends divides by it."""
+        self._imb_ends = abs(self._imb_den) >= IMB_COND * (self.kappa + W * W
+                                                            + self.beta * abs(W))
+        """imb_integral_ends may use the flight's ends (else the closed form imb_integral)."""
 
     # -- propagation --------------------------------------------------------------------
 
@@ -199,6 +209,23 @@ class FlightModel:
             return 0j
         k = self.imb_coeffs(s)
         return k.kz * z0 + k.kv * v0 + k.kf * self.f0 + k.kF * (self.F1 * E0)
+
+    def imb_integral_ends(self, z0: complex, v0: complex, E0: complex, z1: complex,
+                          v1: complex, s: float) -> complex:
+        """imb_integral's K (m s) from both ends (z0, v0) and (z1, v1) of the flight, which
+        the caller already has: multiplying the flight's equation by e^{-i Omega u} and
+        integrating by parts, K (kappa - Omega^2 + i beta Omega) = f0 int e^{-i Omega u} du
+        + F1 E0 s - [z' e^{-i Omega u}]_0^s - (beta + i Omega) [z e^{-i Omega u}]_0^s. Its
+        rounding is absolute, about eps (|v| + (beta + |Omega|) |z| + ...)/|den|, however
+        short the flight. The closed form (imb_integral) near resonance (IMB_COND)."""
+        if not self._imb_ends:
+            return self.imb_integral(z0, v0, E0, s)
+        W = self.Omega
+        w = -1j * W * s
+        rot = cmath.exp(w)
+        rhs = (self.f0 * (s * dd2(w, 0j)) + self.F1 * E0 * s - (v1 * rot - v0)
+               - complex(self.beta, W) * (z1 * rot - z0))
+        return rhs / self._imb_den
 
     def imb_impulse(self, s: float) -> ImbImpulse:
         """Coefficients (cached by s) of the imbalance reaction's angular impulse over a free

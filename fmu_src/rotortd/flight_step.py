@@ -67,13 +67,21 @@ class FlightSteps:
                     return False
         z0, v0 = self._z, self._v
         self._z, self._v = fm.propagate(z0, v0, E, h, cache=True)
-        imb = fm.imb_impulse(h)  # the imbalance reaction's impulse, closed form (cached)
-        rep.P_imb = P = (E.conjugate() * (imb.bz * z0 + imb.bv * v0 + imb.b0) + imb.bE).imag
+        # the imbalance reaction's impulse in closed form (FlightModel.imb_impulse)
+        bz, bv, b0, bE = self._imb_free if self._imb_free_h == h else self._imb_fetch(h)
+        rep.P_imb = P = (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
         rep.T_imb = P / h
         self._advance_psi(h)
         self._on_wall = False
         rep.work = work
         return True
+
+    def _imb_fetch(self, h: float) -> tuple[complex, complex, complex, float]:
+        """(bz, bv, b0, Im bE) of FlightModel.imb_impulse(h), kept for the next proved-free
+        step of the same length (forgotten with the flight model, _set_inputs)."""
+        c = self._fm.imb_impulse(h)
+        self._imb_free_h, self._imb_free = h, (c.bz, c.bv, c.b0, c.bE.imag)
+        return self._imb_free
 
     def _phasor(self) -> complex:
         return cmath.exp(1j * self._psi)
@@ -100,7 +108,7 @@ class FlightSteps:
             loc = ContactLocator(fm, self._z, self._v, E)
             hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
         if hit is None:
-            self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, rem))
+            z0, v0 = self._z, self._v
             if loc is not None and s > 0.0:
                 # the rest of a step after an event: a length that will not recur, whose
                 # flight map costs twelve times the search's modal state (measured)
@@ -108,11 +116,15 @@ class FlightSteps:
             else:  # a whole step: its length recurs and its flight map is cached
                 work.evals += 1
                 self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
+            self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, self._z, self._v, rem))
             self._advance_psi(rem)
             self._on_wall = False
             return h
         ds = min(hit.s, rem)
-        self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, ds))
+        if ds == hit.s:  # the flight's end is the hit's state
+            self._imb_add(rep, E, fm.imb_integral_ends(self._z, self._v, E, hit.z, hit.v, ds))
+        else:
+            self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, ds))
         self._advance_psi(ds)
         if hit.kind == "clear":
             self._z, self._v = hit.z, hit.v

@@ -343,6 +343,12 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """New held inputs (or parameters): rebuild the flight and wall models."""
         self._inputs: tuple[float, complex, float] = (W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
+        self._imb_free_h = math.nan  # FlightSteps._imb_fetch: for this flight model
+        self._imb_free: tuple[complex, complex, complex, float] = (0j, 0j, 0j, 0.0)
+        p = self._p
+        self._imb_eph = cmath.exp(1j * p.phi)  # _imb_add, _imb_close
+        self._imb_seg = p.e_c * p.m * W * W * self._imb_eph  # _imb_add (N/m, complex)
+        self._imb_pint = (math.nan, 0j)  # _imb_close: (dur, int_0^dur e^{i Omega u} du)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
         self._forget_clear_proof()
@@ -379,11 +385,8 @@ class TouchdownCore(FlightSteps, ContactSteps):
     def _imb_add(self, rep: StepReport, E: complex, K: complex) -> None:
         """Add a segment's term -e_c m Omega^2 Im(e^{i phi} E conj(K)) (N m s) to P_imb: K =
         int z e^{-i Omega u} du (m s) over the segment, E = e^{i psi} at its start."""
-        W = self._inputs[0]
-        if W != 0.0 and K != 0:
-            p = self._p
-            rot = cmath.exp(1j * p.phi) * E
-            rep.P_imb -= p.e_c * p.m * W * W * (rot * K.conjugate()).imag
+        if K != 0:
+            rep.P_imb -= (self._imb_seg * E * K.conjugate()).imag
 
     def _imb_close(self, rep: StepReport, start: tuple[complex, complex, complex],
                    dur: float) -> None:
@@ -392,11 +395,13 @@ class TouchdownCore(FlightSteps, ContactSteps):
         z0, v0, E0 = start
         z1, v1, E1 = self._imb_state()
         p, W = self._p, self._inputs[0]
-        eph = cmath.exp(1j * p.phi)
+        eph = self._imb_eph
         A0, A1 = eph * E0, eph * E1
         bound = ((v1.conjugate() * A1 - v0.conjugate() * A0).imag
                  - W * (z1.conjugate() * A1 - z0.conjugate() * A0).real)
-        grav = (p.gravity_force.conjugate() * A0 * phase_integral(W, dur)).imag
+        if self._imb_pint[0] != dur:
+            self._imb_pint = (dur, phase_integral(W, dur))
+        grav = (p.gravity_force.conjugate() * A0 * self._imb_pint[1]).imag
         rep.P_imb += p.e_c * (p.m * bound - grav)
 
     def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
