@@ -137,14 +137,26 @@ def test_proved_free_and_searched_paths_both_checked() -> None:
     assert any(w > 3 for w in works.values()), works
 
 
-@pytest.mark.parametrize("h", [2e-3, 1e-2])
-def test_step_with_impacts_against_dop853(h: float) -> None:
-    """Impacts within the step (a fast flight across the clearance, d = 0.95): impulses
-    counted as P/h through the identity's boundary terms."""
-    p = _gamma(0.3, g=9.81)
-    core = TouchdownCore(p, 0.2j * p.c_r, 0.4 - 0.25j, 0.7)
-    rep = _check_flight_step(core, h, W0, 20.0 + 0j, 1.0)
-    assert len(rep.impacts) >= (1 if h < 5e-3 else 2) and not rep.transitions
+IMPACTING = {
+    # name: (params, z0 / c_r, v0 (m/s), psi0, h, Omega, F_ext, amb_on, least impacts)
+    "fast_2ms": (_gamma(0.3, g=9.81), 0.2j, 0.4 - 0.25j, 0.7, 2e-3, W0, 20.0, 1.0, 1),
+    "fast_10ms": (_gamma(0.3, g=9.81), 0.2j, 0.4 - 0.25j, 0.7, 1e-2, W0, 20.0, 1.0, 2),
+    # undamped resonance: the flight's integral from its closed form (dd4), not its ends
+    "resonance": (BASE.replace(c=0.0, k=BASE.m * 140.0**2), 0.9, 0.05j, 0.3, 2e-2, 140.0,
+                  0j, 1.0, 1),
+    # no spin, bearing off: a drop onto the wall (kappa = Omega = 0, also closed form)
+    "drop_no_spin": (BASE.replace(g=9.81), 0.3, 0.02, 0.5, 2e-2, 0.0, 5.0, 0.0, 1),
+}
+
+
+@pytest.mark.parametrize("name", sorted(IMPACTING))
+def test_step_with_impacts_against_dop853(name: str) -> None:
+    """Impacts within the step (d = 0.95): impulses counted as P/h through the identity's
+    boundary terms; the flights between them searched."""
+    p, zr, v0, psi0, h, W, F, a, least = IMPACTING[name]
+    core = TouchdownCore(p, zr * p.c_r, v0, psi0)
+    rep = _check_flight_step(core, h, W, F, a)
+    assert len(rep.impacts) >= least and not rep.transitions
 
 
 # ------------------------------------------------------------------ contact

@@ -137,8 +137,8 @@ class FlightModel:
         W = self.Omega
         self._imb_den = complex(self.kappa - W * W, self.beta * W)
         """kappa - Omega^2 + i beta Omega (1/s^2): imb_integral_ends divides by it."""
-        self._imb_ends = abs(self._imb_den) >= IMB_COND * (self.kappa + W * W
-                                                            + self.beta * abs(W))
+        self._imb_ends = self._imb_den != 0 and abs(self._imb_den) >= IMB_COND * (
+            self.kappa + W * W + self.beta * abs(W))
         """imb_integral_ends may use the flight's ends (else the closed form imb_integral)."""
 
     # -- propagation --------------------------------------------------------------------
