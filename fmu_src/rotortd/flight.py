@@ -223,8 +223,9 @@ class FlightModel:
         W = self.Omega
         w = -1j * W * s
         rot = cmath.exp(w)
-        rhs = (self.f0 * (s * dd2(w, 0j)) + self.F1 * E0 * s - (v1 * rot - v0)
-               - complex(self.beta, W) * (z1 * rot - z0))
+        rhs = self.F1 * E0 * s - (v1 * rot - v0) - complex(self.beta, W) * (z1 * rot - z0)
+        if self.f0:
+            rhs += self.f0 * (s * dd2(w, 0j))
         return rhs / self._imb_den
 
     def imb_impulse(self, s: float) -> ImbImpulse:

@@ -116,7 +116,13 @@ class FlightSteps:
             else:  # a whole step: its length recurs and its flight map is cached
                 work.evals += 1
                 self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
-            self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, self._z, self._v, rem))
+            if st.first:  # the whole step in one flight: as a proved-free one (closed form)
+                bz, bv, b0, bE = (self._imb_free if self._imb_free_h == rem
+                                  else self._imb_fetch(rem))
+                rep.P_imb = (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
+                st.imb_whole = True
+            else:
+                self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, self._z, self._v, rem))
             self._advance_psi(rem)
             self._on_wall = False
             return h

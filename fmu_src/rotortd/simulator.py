@@ -292,7 +292,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         end (``_advance``), until the step is done or its work bound is reached. Returns
         how far (s) into the step it got."""
         work, cap, s = st.work, st.cap, 0.0
-        start = self._imb_state()
+        start = self._imb_start()
         try:
             while s < h:
                 if work.total > cap:
@@ -300,6 +300,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 work.segs += SEGMENT_WORK
                 mode, s_before = self._mode, s
                 s = self._advance(s, h, t0, rep, st)
+                st.first = False
                 if self._mode != mode:
                     rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
                     if s == s_before and MODE_FREE in (mode, self._mode):
@@ -312,7 +313,8 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
                 f"{len(rep.impacts)} impacts in the step): {exc}")
         rep.work = work.total
-        self._imb_close(rep, start, s)
+        if not st.imb_whole:
+            self._imb_close(rep, start, s)
         return s
 
     def _finish(self, rep: StepReport, t0: float, s: float, h: float, tallied: bool) -> None:
@@ -346,8 +348,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         self._imb_free_h = math.nan  # FlightSteps._imb_fetch: for this flight model
         self._imb_free: tuple[complex, complex, complex, float] = (0j, 0j, 0j, 0.0)
         p = self._p
-        self._imb_eph = cmath.exp(1j * p.phi)  # _imb_add, _imb_close
-        self._imb_seg = p.e_c * p.m * W * W * self._imb_eph  # _imb_add (N/m, complex)
+        self._imb_seg = p.e_c * p.m * W * W * cmath.exp(1j * p.phi)  # _imb_add (N/m)
         self._imb_pint = (math.nan, 0j)  # _imb_close: (dur, int_0^dur e^{i Omega u} du)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
@@ -377,10 +378,21 @@ class TouchdownCore(FlightSteps, ContactSteps):
     # K_seg = int z e^{-i Omega u} du from the segment's start (_imb_add): closed form in
     # flight, rolling and the rub, the error-controlled quadrature in sliding.
 
-    def _imb_state(self) -> tuple[complex, complex, complex]:
-        """(z (m), v (m/s), e^{i psi}) now: the boundary state of the imbalance identity."""
-        z, v = self._wall_state() if self._mode else (self._z, self._v)
-        return z, v, self._phasor()
+    def _imb_start(self) -> tuple[int, complex, complex, float, float, float]:
+        """The state now, as _imb_boundary takes it (a step's start, for _imb_close)."""
+        return self._mode, self._z, self._v, self._theta, self._dtheta, self._psi
+
+    def _imb_boundary(self, mode: int, z: complex, v: complex, theta: float, dtheta: float,
+                      psi: float) -> float:
+        """B (m^2/s), the identity's boundary term Im(conj(z') A) - Omega Re(conj(z) A),
+        A = e^{i(psi + phi)}, of a state: (z, v) in flight; on the wall (mode != 0;
+        z = c_r e^{i theta}, z' = i theta' z) B = -(theta' + Omega) c_r cos(psi + phi -
+        theta)."""
+        W, phi = self._inputs[0], self._p.phi
+        if mode:
+            return -(dtheta + W) * self._p.c_r * math.cos(psi + phi - theta)
+        A = cmath.exp(1j * (psi + phi))
+        return (v.conjugate() * A).imag - W * (z.conjugate() * A).real
 
     def _imb_add(self, rep: StepReport, E: complex, K: complex) -> None:
         """Add a segment's term -e_c m Omega^2 Im(e^{i phi} E conj(K)) (N m s) to P_imb: K =
@@ -388,21 +400,21 @@ class TouchdownCore(FlightSteps, ContactSteps):
         if K != 0:
             rep.P_imb -= (self._imb_seg * E * K.conjugate()).imag
 
-    def _imb_close(self, rep: StepReport, start: tuple[complex, complex, complex],
-                   dur: float) -> None:
+    def _imb_close(self, rep: StepReport,
+                   start: tuple[int, complex, complex, float, float, float], dur: float
+                   ) -> None:
         """Add the identity's boundary and gravity terms (N m s) of a step that started in
-        ``start`` (``_imb_state``) and lasted dur seconds to P_imb."""
-        z0, v0, E0 = start
-        z1, v1, E1 = self._imb_state()
-        p, W = self._p, self._inputs[0]
-        eph = self._imb_eph
-        A0, A1 = eph * E0, eph * E1
-        bound = ((v1.conjugate() * A1 - v0.conjugate() * A0).imag
-                 - W * (z1.conjugate() * A1 - z0.conjugate() * A0).real)
-        if self._imb_pint[0] != dur:
-            self._imb_pint = (dur, phase_integral(W, dur))
-        grav = (p.gravity_force.conjugate() * A0 * self._imb_pint[1]).imag
-        rep.P_imb += p.e_c * (p.m * bound - grav)
+        ``start`` (``_imb_start``) and lasted dur seconds to P_imb: e_c m (B1 - B0) -
+        e_c Im(conj(-i m g) e^{i(psi0 + phi)} int_0^dur e^{i Omega u} du)."""
+        psi0 = start[5]
+        p = self._p
+        P = p.m * (self._imb_boundary(*self._imb_start()) - self._imb_boundary(*start))
+        if p.g != 0.0:  # conj(-i m g) = i m g: Im(i m g X) = m g Re(X)
+            if self._imb_pint[0] != dur:
+                self._imb_pint = (dur, phase_integral(self._inputs[0], dur))
+            A0 = cmath.exp(1j * (psi0 + p.phi))
+            P -= p.m * p.g * (A0 * self._imb_pint[1]).real
+        rep.P_imb += p.e_c * P
 
     def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
         """One segment from s seconds into the step: flight or contact, by the mode."""
