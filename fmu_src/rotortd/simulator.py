@@ -368,15 +368,17 @@ class TouchdownCore(FlightSteps, ContactSteps):
         self._E_diss += rep.E_diss
 
     # ------------------------------------------------------------------ imbalance torque
-    # P_imb = int e_c Im(conj(F_amb + F_ext + F_c) E) dt, E = e^{i(psi + phi)}, held Omega.
-    # The proved-free step takes it in closed form (FlightModel.imb_impulse); every other
-    # step by the identity m z'' = F_amb + F_ext + F_c + G + m e_c Omega^2 E (G gravity),
-    # integrated by parts (z' may jump: impacts are included as impulses):
-    #   P_imb = e_c m (Im[conj(z') E]_0^h - Omega Re[conj(z) E]_0^h
-    #                  - Omega^2 Im int conj(z) E dt) - e_c Im(conj(G) int E dt),
+    # P_imb = int e_c Im(conj(F_amb + F_ext + F_c) E) dt, E = e^{i(psi + phi)}, held Omega
+    # (docs/model.md 8). A step that is one flight (proved free, or searched and finding
+    # nothing) takes it in closed form (FlightModel.imb_impulse); every other step by the
+    # identity m z'' = F_amb + F_ext + F_c + G + m e_c Omega^2 E (G = -i m g), integrated
+    # by parts (z' may jump: impacts are included as impulses):
+    #   P_imb = e_c m ([B]_0^h - Omega^2 Im int conj(z) E dt) - e_c Im(conj(G) int E dt),
+    #   B = Im(conj(z') E) - Omega Re(conj(z) E)   (_imb_boundary),
     # with int conj(z) E dt = sum over the segments of e^{i phi} E_seg conj(K_seg),
-    # K_seg = int z e^{-i Omega u} du from the segment's start (_imb_add): closed form in
-    # flight, rolling and the rub, the error-controlled quadrature in sliding.
+    # K_seg = int z e^{-i Omega u} du from the segment's start (_imb_add): from the ends
+    # of a flight (closed form near resonance), closed form in rolling and the rub, the
+    # error-controlled auxiliary quadrature in sliding.
 
     def _imb_start(self) -> tuple[int, complex, complex, float, float, float]:
         """The state now, as _imb_boundary takes it (a step's start, for _imb_close)."""
