@@ -140,6 +140,8 @@ class FlightModel:
         self._imb_ends = self._imb_den != 0 and abs(self._imb_den) >= IMB_COND * (
             self.kappa + W * W + self.beta * abs(W))
         """imb_integral_ends may use the flight's ends (else the closed form imb_integral)."""
+        self.imb_eph = cmath.exp(1j * p.phi)
+        """e^{i phi}, the imbalance's phase factor."""
 
     # -- propagation --------------------------------------------------------------------
 
@@ -227,6 +229,26 @@ class FlightModel:
         if self.f0:
             rhs += self.f0 * (s * dd2(w, 0j))
         return rhs / self._imb_den
+
+    def imb_impulse_ends(self, z0: complex, v0: complex, E0: complex, z1: complex,
+                         v1: complex, s: float) -> float:
+        """imb_impulse's P_imb (N m s) of this flight from (z0, v0) with e^{i psi0} = E0 to
+        (z1, v1) after s seconds, without the coefficients: -e_c Im(e^{-i phi} conj(E0)
+        int F e^{-i Omega u} du) with K from imb_integral_ends (cheap for a length that
+        does not recur)."""
+        p, m, W = self.params, self.params.m, self.Omega
+        w = -1j * W * s
+        rot = cmath.exp(w)
+        dz = z1 * rot - z0  # [z e^{-i Omega u}]_0^s
+        pint = s * dd2(w, 0j) if self.f0 or self.amb * p.bias_force or self.F_ext else 0j
+        if self._imb_ends:  # K as in imb_integral_ends, sharing rot and pint
+            K = (self.F1 * E0 * s - (v1 * rot - v0) - complex(self.beta, W) * dz
+                 + self.f0 * pint) / self._imb_den
+        else:
+            K = self.imb_integral(z0, v0, E0, s)
+        cc, kk = self.beta * m, self.kappa * m  # a c (N s/m), a k (N/m)
+        IF = (self.amb * p.bias_force + self.F_ext) * pint - cc * (dz + 1j * W * K) - kk * K
+        return -p.e_c * ((E0 * self.imb_eph).conjugate() * IF).imag
 
     def imb_impulse(self, s: float) -> ImbImpulse:
         """Coefficients (cached by s) of the imbalance reaction's angular impulse over a free

@@ -345,10 +345,9 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """New held inputs (or parameters): rebuild the flight and wall models."""
         self._inputs: tuple[float, complex, float] = (W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
-        self._imb_free_h = math.nan  # FlightSteps._imb_fetch: for this flight model
+        self._imb_free_h = math.nan  # FlightSteps._imb_flight: for this flight model
+        self._imb_seen_h = math.nan
         self._imb_free: tuple[complex, complex, complex, float] = (0j, 0j, 0j, 0.0)
-        p = self._p
-        self._imb_seg = p.e_c * p.m * W * W * cmath.exp(1j * p.phi)  # _imb_add (N/m)
         self._imb_pint = (math.nan, 0j)  # _imb_close: (dur, int_0^dur e^{i Omega u} du)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
@@ -400,7 +399,8 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """Add a segment's term -e_c m Omega^2 Im(e^{i phi} E conj(K)) (N m s) to P_imb: K =
         int z e^{-i Omega u} du (m s) over the segment, E = e^{i psi} at its start."""
         if K != 0:
-            rep.P_imb -= (self._imb_seg * E * K.conjugate()).imag
+            p, W = self._p, self._inputs[0]
+            rep.P_imb -= p.e_c * p.m * W * W * (self._fm.imb_eph * E * K.conjugate()).imag
 
     def _imb_close(self, rep: StepReport,
                    start: tuple[int, complex, complex, float, float, float], dur: float
