@@ -94,6 +94,10 @@ P/h)</h3>
 P_n: normal impulse in the step; F_n_peak: peak normal force.</li>
 <li>T_f = &minus;R F_t (sliding, rolling) &minus; R P_t/h (impulses); negative when it brakes a
 positive spin.</li>
+<li>T_imb = e_c Im(conj(F_amb + F_ext + F_c) exp(i(&psi; + &phi;))), the imbalance reaction
+torque on the spin (F_ext without gravity, F_c the contact force, impacts as P/h), exact
+with &Omega; held; a drivetrain that owns the spin inertia integrates
+J &Omega;' = T_drive + T_f + T_imb.</li>
 <li>F_amb_x, F_amb_y = a (F_bias &minus; c z' &minus; k z) at the end of the step.</li>
 <li>x, y, vx, vy; U = z e<sup>&minus;i&psi;</sup>/c<sub>r</sub> (u_re, u_im) and dU/dt with
 t = &Omega; &tau; (du_re, du_im; 0 when &Omega; = 0); r_rel = r/c<sub>r</sub>; whirl_rate =

@@ -33,7 +33,7 @@ from fmpy.fmi2 import (
 
 REAL_OUT = ("x", "y", "vx", "vy", "r_rel", "u_re", "u_im", "du_re", "du_im", "psi",
             "whirl_rate", "v_rel", "F_bx", "F_by", "F_n", "F_n_peak", "P_n", "T_f",
-            "F_amb_x", "F_amb_y", "t_last_impact", "v_last_impact", "E_diss")
+            "T_imb", "F_amb_x", "F_amb_y", "t_last_impact", "v_last_impact", "E_diss")
 INT_OUT = ("mode", "n_impacts", "n_impacts_step")
 
 MESSAGES: list[dict[str, Any]] = []
@@ -188,7 +188,7 @@ def _run_core(rotortd: Any, params: dict, n: int, h: float, Omega: float,
         row = {k: float(getattr(kin, k)) for k in REAL_OUT if hasattr(kin, k)}
         row.update(psi=float(kin.psi_wrapped), F_bx=rep.F_contact.real,
                    F_by=rep.F_contact.imag, F_n=rep.F_n, F_n_peak=rep.F_n_peak, P_n=rep.P_n,
-                   T_f=rep.T_f, t_last_impact=float(core.t_last_impact),
+                   T_f=rep.T_f, T_imb=rep.T_imb, t_last_impact=float(core.t_last_impact),
                    v_last_impact=float(core.v_last_impact), E_diss=float(core.E_diss),
                    mode=int(core.mode), n_impacts=int(core.n_impacts),
                    n_impacts_step=len(rep.impacts))

@@ -102,14 +102,17 @@ class ContactSteps:
             end = seg.run(self._slide_span(rem), st.cap - st.work.total)
             self._slide_step = end.next_step
         st.work.iters += end.tally.work
-        self._end_segment(end, rep, st)
+        self._end_segment(end, rep, st, E)
         return st.later(s, end.duration) if end.duration < rem else h
 
-    def _end_segment(self, end: SegmentEnd, rep: StepReport, st: StepContext | None) -> None:
-        """Apply the end of a contact segment: its state, its contact integrals (into
-        ``rep``) and its event (``st`` may be None only for an end without event)."""
+    def _end_segment(self, end: SegmentEnd, rep: StepReport, st: StepContext | None,
+                     E: complex) -> None:
+        """Apply the end of a contact segment that started with e^{i psi} = E: its state,
+        its contact integrals (into ``rep``) and its event (``st`` may be None only for an
+        end without event)."""
         p = self._p
         rep.add_contact(end.tally, p.m * p.c_r, p.c_r)
+        self._imb_add(rep, E, p.c_r * end.tally.I_z)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_psi(end.duration)
         self._transition(end.event, st)
@@ -122,12 +125,15 @@ class ContactSteps:
         would take the same segment whole: the slip sign agrees with v_rel, and Gn stays
         above the lift-off test (constant on the rotation; bounded below by
         LinearRub.near on the linearised motion)."""
-        rub = self._rub_choice(self._phasor(), True)
+        E = self._phasor()
+        rub = self._rub_choice(E, True)
         if rub is None:
             return False
+        start = self._imb_start()  # (after a lock: its snap is not an impulse)
         end = rub.run(h)
         rep.work = end.tally.work
-        self._end_segment(end, rep, None)
+        self._end_segment(end, rep, None, E)
+        self._imb_close(rep, start, h)
         return True
 
     def _leaves_wall(self, E: complex) -> bool:

@@ -17,6 +17,16 @@ All three matrix functions are written with divided differences of exp on the no
 {l1 s, l2 s}, {0, l1 s, l2 s} and {0, (l1 - i Omega) s, (l2 - i Omega) s} (divdiff.py),
 which are entire in the nodes: one code path covers k = 0, c = 0, critical damping,
 (near-)resonance and Omega = 0 without dividing by anything that can vanish.
+
+The imbalance reaction torque (``imb_integral``, ``imb_impulse``) needs the integral of the
+co-rotating position, K(s) = int_0^s z(u) e^{-i Omega u} du (m s). Integrating Duhamel's
+formula against e^{-i Omega u}, with a = (l1 - i Omega) s, b = (l2 - i Omega) s,
+w = -i Omega s and g(A) = g(l1) I + g[l1, l2] (A - l1 I) for the first row:
+
+    K = (s exp[0, a] - l1 s^2 exp[0, a, b]) z0 + s^2 exp[0, a, b] v0
+        + s^3 exp[0, a, b, w] f0 + s^3 exp[0, 0, a, b] F1 E0,
+
+again entire in the nodes (divdiff.dd4 for the four-node differences).
 """
 
 from __future__ import annotations
@@ -25,9 +35,13 @@ import cmath
 import math
 from typing import NamedTuple
 
-from .divdiff import dd2, dd3
+from .divdiff import dd2, dd3, dd4
 from .params import RotorParams
 
+IMB_COND = 1e-2
+"""imb_integral_ends solves for K from the flight's two ends only when |kappa - Omega^2 +
+i beta Omega| >= IMB_COND (kappa + Omega^2 + beta |Omega|) (rounding amplified at most
+100-fold); nearer resonance, or with kappa = Omega = 0, it uses the closed form."""
 MODAL_GAIN = 4.0
 """Largest ratio of the modal amplitudes to the state's scale for which the search
 evaluates the flight by modes (FlightModel.modes)."""
@@ -50,6 +64,29 @@ class FlightCoeffs(NamedTuple):
     qzs: complex
     qvs: complex
     rot: complex
+
+
+class ImbCoeffs(NamedTuple):
+    """Coefficients of K(s) = int_0^s z(u) e^{-i Omega u} du (m s) over a flight of fixed
+    length s (module docstring): K = kz z0 + kv v0 + kf f0 + kF F1 E0 (kz in s, kv in s^2,
+    kf and kF in s^3), inertial frame."""
+
+    kz: complex
+    kv: complex
+    kf: complex
+    kF: complex
+
+
+class ImbImpulse(NamedTuple):
+    """The imbalance reaction's angular impulse over a free flight of fixed length s, as
+    P_imb = Im(conj(E0) (bz z0 + bv v0 + b0) + bE) (N m s) with E0 = e^{i psi0}:
+    P_imb = e_c Im(int conj(F_amb + F_ext) e^{i(psi + phi)} dt), F_amb = a (F_bias - c z' -
+    k z) (FlightModel.imb_impulse). bz in N s, bv in N s^2, b0 and bE in N m s."""
+
+    bz: complex
+    bv: complex
+    b0: complex
+    bE: complex
 
 
 class FlightModel:
@@ -96,6 +133,15 @@ class FlightModel:
         """Fastest rate of the forced motion (rad/s): |Omega|, sqrt(kappa), beta and
         sqrt(K/c_r), the rate at which the largest force crosses the clearance."""
         self._cache: dict[float, FlightCoeffs] = {}
+        self._imb_cache: dict[float, ImbImpulse] = {}
+        W = self.Omega
+        self._imb_den = complex(self.kappa - W * W, self.beta * W)
+        """kappa - Omega^2 + i beta Omega (1/s^2): imb_integral_ends divides by it."""
+        self._imb_ends = self._imb_den != 0 and abs(self._imb_den) >= IMB_COND * (
+            self.kappa + W * W + self.beta * abs(W))
+        """imb_integral_ends may use the flight's ends (else the closed form imb_integral)."""
+        self.imb_eph = cmath.exp(1j * p.phi)
+        """e^{i phi}, the imbalance's phase factor."""
 
     # -- propagation --------------------------------------------------------------------
 
@@ -144,6 +190,93 @@ class FlightModel:
         z = co.p11 * z0 + co.p12 * v0 + self.f0 * co.qz0 + g * co.qzs
         v = co.p21 * z0 + co.p22 * v0 + self.f0 * co.qv0 + g * co.qvs
         return z, v
+
+    # -- the imbalance reaction torque (module docstring) ---------------------------------
+
+    def imb_coeffs(self, s: float) -> ImbCoeffs:
+        """Coefficients of K(s) = int_0^s z e^{-i Omega u} du (m s) for length s >= 0 (s)."""
+        la, lb = self.l1, self.l2
+        iw = 1j * self.Omega
+        a, b, w = (la - iw) * s, (lb - iw) * s, -iw * s
+        s2 = s * s
+        g12 = s2 * dd3(0j, a, b)
+        s3 = s2 * s
+        return ImbCoeffs(s * dd2(0j, a) - la * g12, g12, s3 * dd4(0j, a, b, w),
+                         s3 * dd4(0j, 0j, a, b))
+
+    def imb_integral(self, z0: complex, v0: complex, E0: complex, s: float) -> complex:
+        """K = int_0^s z(u) e^{-i Omega u} du (m s) of the flight from (z0, v0) with
+        e^{i psi0} = E0: the co-rotating position z e^{-i psi}, integrated, times E0."""
+        if s == 0.0:
+            return 0j
+        k = self.imb_coeffs(s)
+        return k.kz * z0 + k.kv * v0 + k.kf * self.f0 + k.kF * (self.F1 * E0)
+
+    def imb_integral_ends(self, z0: complex, v0: complex, E0: complex, z1: complex,
+                          v1: complex, s: float) -> complex:
+        """imb_integral's K (m s) from both ends (z0, v0) and (z1, v1) of the flight, which
+        the caller already has: multiplying the flight's equation by e^{-i Omega u} and
+        integrating by parts, K (kappa - Omega^2 + i beta Omega) = f0 int e^{-i Omega u} du
+        + F1 E0 s - [z' e^{-i Omega u}]_0^s - (beta + i Omega) [z e^{-i Omega u}]_0^s. Its
+        rounding is absolute, about eps (|v| + (beta + |Omega|) |z| + ...)/|den|, however
+        short the flight. The closed form (imb_integral) near resonance (IMB_COND)."""
+        if not self._imb_ends:
+            return self.imb_integral(z0, v0, E0, s)
+        W = self.Omega
+        w = -1j * W * s
+        rot = cmath.exp(w)
+        rhs = self.F1 * E0 * s - (v1 * rot - v0) - complex(self.beta, W) * (z1 * rot - z0)
+        if self.f0:
+            rhs += self.f0 * (s * dd2(w, 0j))
+        return rhs / self._imb_den
+
+    def imb_impulse_ends(self, z0: complex, v0: complex, E0: complex, z1: complex,
+                         v1: complex, s: float) -> float:
+        """imb_impulse's P_imb (N m s) of this flight from (z0, v0) with e^{i psi0} = E0 to
+        (z1, v1) after s seconds, without the coefficients: -e_c Im(e^{-i phi} conj(E0)
+        int F e^{-i Omega u} du) with K from imb_integral_ends (cheap for a length that
+        does not recur)."""
+        p, m, W = self.params, self.params.m, self.Omega
+        w = -1j * W * s
+        rot = cmath.exp(w)
+        dz = z1 * rot - z0  # [z e^{-i Omega u}]_0^s
+        pint = s * dd2(w, 0j) if self.f0 or self.amb * p.bias_force or self.F_ext else 0j
+        if self._imb_ends:  # K as in imb_integral_ends, sharing rot and pint
+            K = (self.F1 * E0 * s - (v1 * rot - v0) - complex(self.beta, W) * dz
+                 + self.f0 * pint) / self._imb_den
+        else:
+            K = self.imb_integral(z0, v0, E0, s)
+        cc, kk = self.beta * m, self.kappa * m  # a c (N s/m), a k (N/m)
+        IF = (self.amb * p.bias_force + self.F_ext) * pint - cc * (dz + 1j * W * K) - kk * K
+        return -p.e_c * ((E0 * self.imb_eph).conjugate() * IF).imag
+
+    def imb_impulse(self, s: float) -> ImbImpulse:
+        """Coefficients (cached by s) of the imbalance reaction's angular impulse over a free
+        flight of s seconds (ImbImpulse): with E = e^{i(psi + phi)} and F = F_amb + F_ext,
+        int conj(F) E dt = conj(int F conj(E) dt), int F conj(E) = e^{-i phi} conj(E0) int F
+        e^{-i Omega u} du, and int F e^{-i Omega u} = (a F_bias + F_ext) conj(int e^{i Omega
+        u}) - a c ([z e^{-i Omega u}]_0^s + i Omega K) - a k K, linear in (z0, v0, E0)
+        through the flight map (coeffs) and K (imb_coeffs)."""
+        hit = self._imb_cache.get(s)
+        if hit is not None:
+            return hit
+        p, m = self.params, self.params.m
+        co, k = self.coeffs(s), self.imb_coeffs(s)
+        crot = co.rot.conjugate()
+        cc, kk = self.beta * m, self.kappa * m  # a c (N s/m), a k (N/m)
+        dk = complex(kk, cc * self.Omega)  # a k + i Omega a c
+        fc = m * self.f0 - p.gravity_force  # a F_bias + F_ext (N)
+        az = -cc * (co.p11 * crot - 1.0) - dk * k.kz
+        av = -cc * co.p12 * crot - dk * k.kv
+        a0 = (fc * (s * dd2(-1j * self.Omega * s, 0j)) - cc * self.f0 * co.qz0 * crot
+              - dk * k.kf * self.f0)
+        aE = (-cc * co.qzs * crot - dk * k.kF) * self.F1
+        ph = -p.e_c * cmath.exp(-1j * p.phi)
+        out = ImbImpulse(ph * az, ph * av, ph * a0, ph * aE)
+        if len(self._imb_cache) >= self._CACHE_SIZE:
+            self._imb_cache.clear()
+        self._imb_cache[s] = out
+        return out
 
     def accel(self, z: complex, v: complex, E: complex) -> complex:
         """Free-flight acceleration z'' (m/s^2) at state (z, v) and phasor E = e^{i psi}."""

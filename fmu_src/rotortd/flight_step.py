@@ -66,11 +66,34 @@ class FlightSteps:
                 work += 1
                 if not flight_is_clear(fm, self._z, self._v, E, h):
                     return False
-        self._z, self._v = fm.propagate(self._z, self._v, E, h, cache=True)
+        z0, v0 = self._z, self._v
+        self._z, self._v = fm.propagate(z0, v0, E, h, cache=True)
+        if self._imb_free_h == h:  # the imbalance reaction's impulse, closed form (cached)
+            bz, bv, b0, bE = self._imb_free
+            rep.P_imb = P = (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
+        else:
+            rep.P_imb = P = self._imb_flight(z0, v0, E, h)
+        rep.T_imb = P / h
         self._advance_psi(h)
         self._on_wall = False
         rep.work = work
         return True
+
+    def _imb_flight(self, z0: complex, v0: complex, E: complex, h: float) -> float:
+        """P_imb (N m s) of a flight of h seconds from (z0, v0, E) that ended in (_z, _v):
+        closed form, FlightModel.imb_impulse; its coefficients are computed once the
+        length recurs under the same flight model, and kept on the core for the next such
+        flight (forgotten with the flight model, _set_inputs); a first flight of a length,
+        as each spin sub-step of SpinCoupler is, takes FlightModel.imb_impulse_ends."""
+        fm = self._fm
+        if self._imb_free_h != h:
+            if self._imb_seen_h != h:
+                self._imb_seen_h = h
+                return fm.imb_impulse_ends(z0, v0, E, self._z, self._v, h)
+            c = fm.imb_impulse(h)
+            self._imb_free_h, self._imb_free = h, (c.bz, c.bv, c.b0, c.bE.imag)
+        bz, bv, b0, bE = self._imb_free
+        return (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
 
     def _phasor(self) -> complex:
         return cmath.exp(1j * self._psi)
@@ -102,6 +125,7 @@ class FlightSteps:
             loc = ContactLocator(fm, self._z, self._v, E)
             hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
         if hit is None:
+            z0, v0 = self._z, self._v
             if loc is not None and s > 0.0:
                 # the rest of a step after an event: a length that will not recur, whose
                 # flight map costs twelve times the search's modal state (measured)
@@ -109,10 +133,19 @@ class FlightSteps:
             else:  # a whole step: its length recurs and its flight map is cached
                 work.evals += 1
                 self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
+            if st.first:  # the whole step in one flight: as a proved-free one (closed form)
+                rep.P_imb = self._imb_flight(z0, v0, E, rem)
+                st.imb_whole = True
+            else:
+                self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, self._z, self._v, rem))
             self._advance_psi(rem)
             self._on_wall = False
             return h
         ds = min(hit.s, rem)
+        if ds == hit.s:  # the flight's end is the hit's state
+            self._imb_add(rep, E, fm.imb_integral_ends(self._z, self._v, E, hit.z, hit.v, ds))
+        else:
+            self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, ds))
         self._advance_psi(ds)
         if hit.kind == "clear":
             self._z, self._v = hit.z, hit.v

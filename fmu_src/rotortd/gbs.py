@@ -8,6 +8,7 @@ long at tight tolerances, and it shares no coefficients with the validation inte
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 Vector = list[float]
@@ -44,12 +45,23 @@ def extrapolated_step(
     k_min: int = 3,
     k_max: int = len(SEQUENCE),
     k_fixed: int | None = None,
+    aux_scale: Sequence[float] = (),
+    aux_evals: list[int] | None = None,
 ) -> tuple[Vector, float, int, int]:
     """One extrapolated step of length H from (u0, y0) with f0 = y'(u0).
 
     ``scale[i]`` is the tolerance for component i (components beyond len(scale) are not
     error-controlled). Returns (y, err, k, nfev): err <= 1 means accepted at column k;
     with ``k_fixed`` exactly that many columns are used (for event re-integration).
+
+    ``aux_scale`` gives tolerances of the last len(aux_scale) components (auxiliary
+    quadratures) that must not change the others: they take no part in the acceptance or
+    in k; once the step is accepted (or with ``k_fixed``), if their own error ratio exceeds
+    1, further columns are built (up to k_max) for them alone, and y carries the
+    controlled components of column k and the auxiliary ones of the first column where
+    their ratio is <= 1 (or of k_max). nfev does not count those further sweeps (so that
+    the caller's work count stays what it was without auxiliary components); their
+    right-hand sides are added to ``aux_evals[0]`` when given.
     """
     table: list[Vector] = []
     err = float("inf")
@@ -64,9 +76,40 @@ def extrapolated_step(
         if j >= 1:
             err = _error_ratio(extr[j], extr[j - 1], scale)
             if k_fixed is None and j + 1 >= k_min and err <= 1.0:
+                if aux_scale:
+                    y = _refine_aux(sweep, u0, y0, f0, H, extr, j, aux_scale, k_max, aux_evals)
+                    return y, err, j + 1, nfev
                 return extr[j], err, j + 1, nfev
         table = extr
+    if aux_scale and k_fixed is not None:
+        y = _refine_aux(sweep, u0, y0, f0, H, table, k_stop - 1, aux_scale, k_max, aux_evals)
+        return y, err, k_stop, nfev
     return table[-1], err, k_stop, nfev
+
+
+def _refine_aux(sweep: Sweep, u0: float, y0: Sequence[float], f0: Sequence[float], H: float,
+                row: list[Vector], j: int, aux_scale: Sequence[float], k_max: int,
+                aux_evals: list[int] | None) -> Vector:
+    """extrapolated_step's end with auxiliary components (its docstring): y of the tableau
+    row ``row`` of column j (0-based), which was accepted, with its auxiliary components
+    refined by further columns until their error ratio is <= 1."""
+    na = len(aux_scale)
+    y = row[j]
+    jj = j
+    a_err = _error_ratio(y[-na:], row[j - 1][-na:], aux_scale) if j >= 1 else math.inf
+    while not a_err <= 1.0 and jj + 1 < k_max:
+        jj += 1
+        n = SEQUENCE[jj]
+        new = [sweep(u0, y0, f0, H, n)]
+        if aux_evals is not None:
+            aux_evals[0] += n
+        for r, b in zip(_RATIOS[jj], row):
+            new.append([x + (x - w) / r for x, w in zip(new[-1], b)])
+        a_err = _error_ratio(new[jj][-na:], new[jj - 1][-na:], aux_scale)
+        row = new
+    if jj > j:
+        y = y[:-na] + row[jj][-na:]
+    return y
 
 
 _RATIOS = tuple(

@@ -30,7 +30,10 @@ class StepReport:
     Also the step's accumulator: while the step runs, impacts and contact segments add
     their impulses to P_contact, P_n, P_t, E_diss and F_n_peak (the contact force's peak;
     the impacts' P_n/h join it at the end), and the step's end turns the impulses into the
-    averages F_contact, F_n and T_f (``TouchdownCore._finish``)."""
+    averages F_contact, F_n and T_f (``TouchdownCore._finish``). P_imb, the imbalance
+    reaction's angular impulse, is gathered as docs/model.md says (``TouchdownCore._imb_*``):
+    each segment adds its integral of the co-rotating position, the step's end adds the
+    boundary terms; T_imb = P_imb/h."""
 
     status: int = STATUS_OK
     message: str = ""
@@ -50,6 +53,14 @@ class StepReport:
     """Impulse of the contact on the rotor over the step (N s): F_contact = P_contact/h."""
     P_t: float = 0.0
     """Signed friction impulse (N s): T_f = -R P_t/h."""
+    P_imb: float = 0.0
+    """Angular impulse (N m s) of the imbalance reaction on the spin over the step, held
+    Omega: int e_c Im(conj(F_amb + F_ext + F_c) e^{i(psi + phi)}) dt, impacts as impulses
+    (F_amb = a (F_bias - c z' - k z); F_ext without gravity; F_c the contact force on the
+    rotor). T_imb = P_imb/h."""
+    T_imb: float = 0.0
+    """Imbalance reaction torque on the spin (N m), step average P_imb/h: a drivetrain that
+    owns the spin inertia integrates J Omega' = T_drive + T_f + T_imb."""
 
     def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
         """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
@@ -90,7 +101,8 @@ class StepContext:
     never stored on the core: its work and work bound, the rounding error of its local
     time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
 
-    __slots__ = ("cap", "roll_lenient", "rub_refused", "s_lo", "sticky_at", "work")
+    __slots__ = ("cap", "first", "imb_whole", "roll_lenient", "rub_refused", "s_lo",
+                 "sticky_at", "work")
 
     def __init__(self, cap: int, rub_refused: bool = False) -> None:
         self.work = Work()
@@ -99,6 +111,8 @@ class StepContext:
         self.roll_lenient = False  # zero slip proved stuck (_transition)
         self.sticky_at = math.nan  # where flight and contact swapped at N = 0
         self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
+        self.first = True  # in the step's first segment (the step loop clears it)
+        self.imb_whole = False  # P_imb of the whole step in closed form (_advance_free)
 
     def later(self, s: float, ds: float) -> float:
         """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step

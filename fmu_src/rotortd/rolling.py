@@ -149,6 +149,7 @@ class Rolling:
             + wf.eu * self.E0 * phase_integral(wf.Omega, x)
         )
         tally.I_e = 0.0
+        tally.I_z = e0 * phase_integral(self.dtheta - wf.Omega, x)  # theta = theta0 + dtheta u
         samples = (self.gn_gt(x * j / 8.0)[0] for j in range(9))
         tally.peak = max(0.0, *samples)
         tally.work += 1

@@ -231,9 +231,12 @@ class LinearRub(_RubStep):
         tal.I_n = eq.Gn * rem + gx * int_x + gy * int_y
         tal.I_t = mus * tal.I_n
         ring = eq.Gn * phase_integral(W, rem) + complex(gx, eq.Gn) * Kx + gy * Ky
-        tal.I_c = -complex(1.0, mus) * cmath.exp(1j * (self.theta0 - x0)) * ring
+        e0 = cmath.exp(1j * (self.theta0 - x0))  # e^{i(theta - Omega u - x)}
+        tal.I_c = -complex(1.0, mus) * e0 * ring
         tal.I_e = mus * ((wf.wr + W) * tal.I_n + eq.Gn * int_y)
         tal.peak = eq.Gn + max(gx * x0 + gy * y0, gx * x1 + gy * y1)
+        # theta - Omega u = theta0 - x0 + x: e^{ix} to first order, as the force's direction
+        tal.I_z = e0 * complex(rem, int_x)
         tal.work = 1
         return SegmentEnd(rem, self.theta0 + W * rem + dx, W + y1, None, tal)
 
@@ -349,10 +352,13 @@ class QuadraticRub(_RubStep):
         tal.I_t = mus * tal.I_n
         ring = (Gn * phase_integral(W, rem) + complex(gx, Gn) * Kx + gy * Ky
                 + complex(gxx - 0.5 * Gn, gx) * K1 + 1j * gy * K2 + K3)
-        tal.I_c = -complex(1.0, mus) * cmath.exp(1j * (self.theta0 - x0)) * ring
+        e0 = cmath.exp(1j * (self.theta0 - x0))  # e^{i(theta - Omega u - x)}
+        tal.I_c = -complex(1.0, mus) * e0 * ring
         tal.I_e = mus * ((wf.wr + W) * tal.I_n + Gn * int_y + (gx * S2 + gy * S3).real)
         tal.peak = Gn + max(gx * x0 + gy * y0 + gxx * q0[0] + q0[2],
                             gx * x + gy * y + gxx * q[0] + q[2])
+        # e^{ix} to second order: int (1 + i x - x^2/2), int x^2 = S1 to that order
+        tal.I_z = e0 * complex(rem - 0.5 * S1.real, int_x)
         tal.work = 1
         return SegmentEnd(rem, self.theta0 + W * rem + (x - x0), W + y, None, tal)
 
@@ -375,9 +381,11 @@ class LockedRub:
         tal = ContactTally()
         tal.I_n = gn * rem
         tal.I_t = ft * rem
-        tal.I_c = -complex(gn, ft) * cmath.exp(1j * theta) * phase_integral(wf.Omega, rem)
+        e0 = cmath.exp(1j * theta)
+        tal.I_c = -complex(gn, ft) * e0 * phase_integral(wf.Omega, rem)
         tal.I_e = ft * (wf.wr + dtheta) * rem
         tal.peak = gn
+        tal.I_z = e0 * phase_integral(dtheta - wf.Omega, rem)
         tal.work = 1
         return SegmentEnd(rem, theta + wf.Omega * rem, dtheta, None, tal)
 

@@ -43,7 +43,7 @@ from .report import (
 from .rub import RubEquilibrium
 from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 from .state import CoreState
-from .wall import ContactWorkExceeded, WallForces
+from .wall import ContactWorkExceeded, WallForces, phase_integral
 
 __all__ = [
     "ETA_HEIGHT", "ETA_TIME", "LOCK_TOL", "MODE_FREE", "MODE_ROLLING", "MODE_SLIDING",
@@ -295,6 +295,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         end (``_advance``), until the step is done or its work bound is reached. Returns
         how far (s) into the step it got."""
         work, cap, s = st.work, st.cap, 0.0
+        start = self._imb_start()
         try:
             while s < h:
                 if work.total > cap:
@@ -302,6 +303,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 work.segs += SEGMENT_WORK
                 mode, s_before = self._mode, s
                 s = self._advance(s, h, t0, rep, st)
+                st.first = False
                 if self._mode != mode:
                     rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
                     if s == s_before and MODE_FREE in (mode, self._mode):
@@ -314,6 +316,8 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
                 f"{len(rep.impacts)} impacts in the step): {exc}")
         rep.work = work.total
+        if not st.imb_whole:
+            self._imb_close(rep, start, s)
         return s
 
     def _finish(self, rep: StepReport, t0: float, s: float, h: float, tallied: bool) -> None:
@@ -344,6 +348,10 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """New held inputs (or parameters): rebuild the flight and wall models."""
         self._inputs: tuple[float, complex, float] = (W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
+        self._imb_free_h = math.nan  # FlightSteps._imb_flight: for this flight model
+        self._imb_seen_h = math.nan
+        self._imb_free: tuple[complex, complex, complex, float] = (0j, 0j, 0j, 0.0)
+        self._imb_pint = (math.nan, 0j)  # _imb_close: (dur, int_0^dur e^{i Omega u} du)
         self._wf = WallForces.build(self._p, W, F, a)
         self._rub_eqs: list[RubEquilibrium] | None = None  # forward_rub_equilibria, lazily
         self._forget_clear_proof()
@@ -357,8 +365,61 @@ class TouchdownCore(FlightSteps, ContactSteps):
         for imp in rep.impacts:
             rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
         rep.T_f = -self._p.R * rep.P_t * inv
+        rep.T_imb = rep.P_imb * inv
         rep.mode = self._mode
         self._E_diss += rep.E_diss
+
+    # ------------------------------------------------------------------ imbalance torque
+    # P_imb = int e_c Im(conj(F_amb + F_ext + F_c) E) dt, E = e^{i(psi + phi)}, held Omega
+    # (docs/model.md 9). A step that is one flight (proved free, or searched and finding
+    # nothing) takes it in closed form (FlightModel.imb_impulse); every other step by the
+    # identity m z'' = F_amb + F_ext + F_c + G + m e_c Omega^2 E (G = -i m g), integrated
+    # by parts (z' may jump: impacts are included as impulses):
+    #   P_imb = e_c m ([B]_0^h - Omega^2 Im int conj(z) E dt) - e_c Im(conj(G) int E dt),
+    #   B = Im(conj(z') E) - Omega Re(conj(z) E)   (_imb_boundary),
+    # with int conj(z) E dt = sum over the segments of e^{i phi} E_seg conj(K_seg),
+    # K_seg = int z e^{-i Omega u} du from the segment's start (_imb_add): from the ends
+    # of a flight (closed form near resonance), closed form in rolling and the rub, the
+    # error-controlled auxiliary quadrature in sliding.
+
+    def _imb_start(self) -> tuple[int, complex, complex, float, float, float]:
+        """The state now, as _imb_boundary takes it (a step's start, for _imb_close)."""
+        return self._mode, self._z, self._v, self._theta, self._dtheta, self._psi
+
+    def _imb_boundary(self, mode: int, z: complex, v: complex, theta: float, dtheta: float,
+                      psi: float) -> float:
+        """B (m^2/s), the identity's boundary term Im(conj(z') A) - Omega Re(conj(z) A),
+        A = e^{i(psi + phi)}, of a state: (z, v) in flight; on the wall (mode != 0;
+        z = c_r e^{i theta}, z' = i theta' z) B = -(theta' + Omega) c_r cos(psi + phi -
+        theta)."""
+        W, phi = self._inputs[0], self._p.phi
+        if mode:
+            return -(dtheta + W) * self._p.c_r * math.cos(psi + phi - theta)
+        A = cmath.exp(1j * (psi + phi))
+        return (v.conjugate() * A).imag - W * (z.conjugate() * A).real
+
+    def _imb_add(self, rep: StepReport, E: complex, K: complex) -> None:
+        """Add a segment's term -e_c m Omega^2 Im(e^{i phi} E conj(K)) (N m s) to P_imb: K =
+        int z e^{-i Omega u} du (m s) over the segment, E = e^{i psi} at its start."""
+        if K != 0:
+            p, W = self._p, self._inputs[0]
+            rep.P_imb -= p.e_c * p.m * W * W * (self._fm.imb_eph * E * K.conjugate()).imag
+
+    def _imb_close(self, rep: StepReport,
+                   start: tuple[int, complex, complex, float, float, float], dur: float
+                   ) -> None:
+        """Add the identity's boundary and gravity terms (N m s) of a step that started in
+        ``start`` (``_imb_start``) and lasted dur seconds to P_imb: e_c m (B1 - B0) -
+        e_c Im(conj(-i m g) e^{i(psi0 + phi)} int_0^dur e^{i Omega u} du)."""
+        psi0 = start[5]
+        p = self._p
+        P = p.m * (self._imb_boundary(*self._imb_start()) - self._imb_boundary(*start))
+        if p.g != 0.0:  # conj(-i m g) = i m g: Im(i m g X) = m g Re(X)
+            if self._imb_pint[0] != dur:
+                self._imb_pint = (dur, phase_integral(self._inputs[0], dur))
+            A0 = cmath.exp(1j * (psi0 + p.phi))
+            P -= p.m * p.g * (A0 * self._imb_pint[1]).real
+        rep.P_imb += p.e_c * P
 
     def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
         """One segment from s seconds into the step: flight or contact, by the mode."""

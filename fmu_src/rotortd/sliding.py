@@ -2,7 +2,10 @@
 
 Frame and units as in ``rotortd.contact``: Ft = mu s Gn, s = sign(v_rel), at 1e-13 relative
 tolerance, with the step's contact integrals carried as error-controlled quadratures (the
-contact force by parts near a steady whirl, Sliding.rhs).
+contact force by parts near a steady whirl, Sliding.rhs), and the integral of the
+co-rotating position e^{i(theta - Omega u)} (for the imbalance torque) as an auxiliary
+quadrature, error-controlled on its own without changing the others (gbs.extrapolated_step's
+aux_scale).
 """
 
 from __future__ import annotations
@@ -67,9 +70,19 @@ class Sliding:
         """RTOL times the scale of the contact force per m c_r (1/s^2)."""
         self.nu = 0.0
         """Rate (rad/s) of the integration by parts of the contact force; 0: plain (run)."""
+        W2 = wf.Omega * wf.Omega
+        self.aux_rate = max(RTOL, self.force_tol / W2) if W2 > 0.0 else 1.0
+        """Error scale (1) per second of step of the auxiliary quadrature Z = int e^{i(theta -
+        Omega u)} du, whose term in the imbalance torque is e_c m c_r Omega^2 Z: RTOL of the
+        contact force's scale, as the other quadratures (force_tol/Omega^2), and at least
+        RTOL of its integrand (modulus 1); loose at Omega = 0, where the term vanishes."""
+        self.aux_evals = [0]
+        """Right-hand sides spent on refining Z alone (gbs.extrapolated_step's aux_evals):
+        not in the work count, which stays that of the integration without Z."""
 
     def rhs(self, u: float, y: list[float]) -> list[float]:
-        """d/du of (theta, theta', I_n, J_x, J_y, I_e) at local time u (s).
+        """d/du of (theta, theta', I_n, J_x, J_y, I_e, Z_x, Z_y) at local time u (s), with
+        Z = int e^{i(theta - Omega u)} du (s), the auxiliary quadrature (ContactTally.I_z).
 
         With nu = 0, J = I_c, the integral of the contact force F = -(gn + i ft) e^{i theta}.
         Otherwise J integrates D = F' - i nu F = -(1 + i mu s)(gn' + i (theta' - nu) gn)
@@ -79,7 +92,8 @@ class Sliding:
         """
         wf = self.wf
         th, dth = y[0], y[1]
-        euE = wf.eu * (self.E0 * cmath.exp(1j * wf.Omega * u))
+        rot = cmath.exp(1j * wf.Omega * u)
+        euE = wf.eu * (self.E0 * rot)
         Q = wf.q0 + euE
         co, sn = math.cos(th), math.sin(th)  # P = Q e^{-i theta}, as real parts
         gn = (Q.real * co + Q.imag * sn) - wf.kappa + dth * dth
@@ -92,7 +106,8 @@ class Sliding:
             ar, ai = (V.real * sn - V.imag * co) + 2.0 * dth * ddth, (dth - self.nu) * gn
             br, bi = ar - self.mus * ai, ai + self.mus * ar
             jx, jy = bi * sn - br * co, -(br * sn) - bi * co
-        return [dth, ddth, gn, jx, jy, ft * (wf.wr + dth)]
+        zx, zy = co * rot.real + sn * rot.imag, sn * rot.real - co * rot.imag
+        return [dth, ddth, gn, jx, jy, ft * (wf.wr + dth), zx, zy]
 
     def midpoint_sweep(self, u0: float, y0: list[float], f0: list[float], H: float,
                        n: int) -> list[float]:
@@ -108,11 +123,13 @@ class Sliding:
         try:  # an overflowing trial step (cos(inf)) is rejected by its NaN error ratio
             h = H / n
             h2 = 2.0 * h
-            m0, m1, m2, m3, m4, m5 = y0  # the previous midpoint iterate, then the current one
-            c0, c1, c2 = m0 + h * f0[0], m1 + h * f0[1], m2 + h * f0[2]
+            m0, m1, m2, m3, m4, m5, m6, m7 = y0  # the previous midpoint iterate, then the
+            c0, c1, c2 = m0 + h * f0[0], m1 + h * f0[1], m2 + h * f0[2]  # current one
             c3, c4, c5 = m3 + h * f0[3], m4 + h * f0[4], m5 + h * f0[5]
+            c6, c7 = m6 + h * f0[6], m7 + h * f0[7]
             for i in range(1, n + 1):
-                euE = eu * (E0 * exp(iW * (u0 + i * h if i < n else u0 + H)))
+                rot = exp(iW * (u0 + i * h if i < n else u0 + H))
+                euE = eu * (E0 * rot)
                 Q = q0 + euE
                 Qr, Qi = Q.real, Q.imag
                 co, sn = cos(c0), sin(c0)
@@ -127,6 +144,8 @@ class Sliding:
                     br, bi = ar - mus * ai, ai + mus * ar
                     f3, f4 = bi * sn - br * co, -(br * sn) - bi * co
                 f5 = ft * (wr + c1)
+                rr, ri = rot.real, rot.imag
+                f6, f7 = co * rr + sn * ri, sn * rr - co * ri
                 if i == n:
                     break
                 m0, c0 = c0, m0 + h2 * c1
@@ -135,6 +154,8 @@ class Sliding:
                 m3, c3 = c3, m3 + h2 * f3
                 m4, c4 = c4, m4 + h2 * f4
                 m5, c5 = c5, m5 + h2 * f5
+                m6, c6 = c6, m6 + h2 * f6
+                m7, c7 = c7, m7 + h2 * f7
             return [
                 0.5 * (c0 + m0 + h * c1),
                 0.5 * (c1 + m1 + h * f1),
@@ -142,9 +163,11 @@ class Sliding:
                 0.5 * (c3 + m3 + h * f3),
                 0.5 * (c4 + m4 + h * f4),
                 0.5 * (c5 + m5 + h * f5),
+                0.5 * (c6 + m6 + h * f6),
+                0.5 * (c7 + m7 + h * f7),
             ]
         except (ValueError, OverflowError):
-            return [math.nan] * 6
+            return [math.nan] * 8
 
     def force(self, u: float, theta: float, dtheta: float) -> complex:
         """Contact force per m c_r (1/s^2, inertial) at local time u in state (theta, theta')."""
@@ -166,7 +189,7 @@ class Sliding:
 
         Raises ContactWorkExceeded, saying where it stopped, before an integrator step
         once the segment has used more than ``limit`` work units (right-hand sides)."""
-        y = [self.theta0, self.dtheta0, 0.0, 0.0, 0.0, 0.0]
+        y = [self.theta0, self.dtheta0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         u = 0.0
         H0 = self.step0
         H = min(H0 if math.isfinite(H0) else 0.05 / self.w, self.h_max)
@@ -188,7 +211,8 @@ class Sliding:
             f0 = self.rhs(u, y)
             scale = self._step_scale(rates, step, y)
             y_new, err, k, nfev = gbs.extrapolated_step(
-                self.midpoint_sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN
+                self.midpoint_sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN,
+                aux_scale=self._aux_scale(step, y), aux_evals=self.aux_evals,
             )
             tally.work += nfev + GBS_STEP_WORK
             if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
@@ -221,11 +245,19 @@ class Sliding:
             rates[3] * step + RTOL * abs(y[5]) + SCALE_FLOOR,
         ]
 
+    def _aux_scale(self, step: float, y: list[float]) -> tuple[float, float]:
+        """Error scales (s) of the auxiliary quadrature Z = int e^{i(theta - Omega u)} du of
+        one step: aux_rate times the step plus RTOL of its accumulated value, at least
+        SCALE_FLOOR."""
+        z = self.aux_rate * step + RTOL * abs(complex(y[6], y[7])) + SCALE_FLOOR
+        return z, z
+
     def _store_integrals(self, tally: ContactTally, y: list[float], u: float) -> None:
         tally.I_n = y[2]
         tally.I_c = self.contact_impulse(y, u)
         tally.I_t = self.mus * y[2]
         tally.I_e = y[5]
+        tally.I_z = complex(y[6], y[7])
 
     def contact_impulse(self, y: list[float], u: float) -> complex:
         """I_c (1/s, inertial): the integral of the contact force per m c_r over [0, u],
@@ -250,7 +282,8 @@ class Sliding:
 
         def at(x: float) -> tuple[list[float], float]:
             yx, _, _, nfev = gbs.extrapolated_step(
-                self.midpoint_sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4)
+                self.midpoint_sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4),
+                aux_scale=self._aux_scale(x, y), aux_evals=self.aux_evals,
             )
             tally.work += nfev + GBS_STEP_WORK
             gn, sv = self.events(yx, u + x)

@@ -108,7 +108,9 @@ class ContactTally:
 
     I_n = int Gn (1/s), I_c = int of the contact force on the rotor / (m c_r) (complex,
     1/s), I_t = int Ft (1/s), I_e = int Ft (wr + theta') (1/s^2; times m c_r^2 gives J),
-    peak = max Gn seen (1/s^2).
+    peak = max Gn seen (1/s^2), I_z = int e^{i(theta(u) - Omega u)} du (s; times c_r: the
+    integral of z e^{-i Omega u} over the segment, u from its start, for the imbalance
+    reaction torque, TouchdownCore._imb_add).
     """
 
     I_n: float = 0.0
@@ -117,6 +119,7 @@ class ContactTally:
     I_e: float = 0.0
     peak: float = 0.0
     work: int = 0
+    I_z: complex = 0j
 
 
 @dataclass

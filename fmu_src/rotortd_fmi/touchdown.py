@@ -261,7 +261,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             self._publish_counters()
         self._publish_step_outputs(rep, len(rep.impacts))
         total = (sum(self._kinematics) + rep.F_contact.real + rep.F_contact.imag + rep.F_n
-                 + rep.F_n_peak + rep.P_n + rep.T_f + omega + self.E_diss)
+                 + rep.F_n_peak + rep.P_n + rep.T_f + rep.T_imb + omega + self.E_diss)
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
         if rep.status == 0 and abs(core.t - t_target) <= tol:
@@ -311,9 +311,11 @@ class RotorTouchdownAdapter(GuardedSlave):
     def _publish_step_outputs(self, rep: Any, n_step: int) -> None:
         if rep is None:
             self.F_bx = self.F_by = self.F_n = self.F_n_peak = self.P_n = self.T_f = 0.0
+            self.T_imb = 0.0
         else:
             self.F_bx, self.F_by = rep.F_contact.real, rep.F_contact.imag
             self.F_n, self.F_n_peak, self.P_n, self.T_f = rep.F_n, rep.F_n_peak, rep.P_n, rep.T_f
+            self.T_imb = rep.T_imb
         self.n_impacts_step = n_step
 
     def _append_impacts(self, impacts: list[Any]) -> None:
