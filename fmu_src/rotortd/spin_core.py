@@ -124,10 +124,21 @@ class SpinCore(TouchdownCore):
         self._inputs = (self._inputs[0], F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
         rep = StepReport(work_cap=cap)
-        t0 = self._t
+        t0, W0 = self._t, self._inputs[0]
         s = self._spin_segments(h, t0, held, rep, StepContext(cap))
         self._finish(rep, t0, s, h, True)
+        self._imbalance_torque(rep, W0, held.T_drive, h if s >= h else self._t - t0)
         return rep
+
+    def _imbalance_torque(self, rep: StepReport, W0: float, T_drive: float,
+                          span: float) -> None:
+        """The imbalance reaction torque e_c Im(conj(F_amb + F_ext + F_c) E) over the step
+        (docs/model.md 9), from the spin's balance J dOmega = int (T_drive + T_f + T_imb):
+        P_imb = J (Omega - W0) - T_drive span + R P_t (N m s), T_imb = P_imb/span (N m);
+        its rounding is about eps J |Omega| (N m s)."""
+        if span > 0.0:
+            rep.P_imb = self._J * (self._inputs[0] - W0) - T_drive * span + self._p.R * rep.P_t
+            rep.T_imb = rep.P_imb / span
 
     def _spin_segments(self, h: float, t0: float, held: HeldInputs, rep: StepReport,
                        st: StepContext) -> float:

@@ -78,9 +78,10 @@ TABLE: tuple[Var, ...] = (
     output("T_f", "N.m", "Friction torque on the spin, step-averaged; < 0 brakes a positive "
                          "spin"),
     output("T_imb", "N.m", "Imbalance reaction torque on the spin e_c Im(conj(F_amb + F_ext + "
-                           "F_c) exp(i(psi + phi))), step-averaged with Omega held, impacts "
-                           "as P/h; a drivetrain that owns the spin inertia integrates "
-                           "J Omega' = T_drive + T_f + T_imb"),
+                           "F_c) exp(i(psi + phi))), step-averaged, impacts as P/h; a "
+                           "drivetrain that owns the spin inertia integrates "
+                           "J Omega' = T_drive + T_f + T_imb (with integrate_spin the same "
+                           "torque, already in the spin state)"),
     output("F_amb_x", "N", "Magnetic bearing force x at the end of the step"),
     output("F_amb_y", "N", "Magnetic bearing force y at the end of the step"),
     output("t_last_impact", "s", "Time of the last impact; 0 before any impact"),
