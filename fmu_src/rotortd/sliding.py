@@ -77,8 +77,8 @@ class Sliding:
         contact force's scale, as the other quadratures (force_tol/Omega^2), and at least
         RTOL of its integrand (modulus 1); loose at Omega = 0, where the term vanishes."""
         self.aux_evals = [0]
-        """Right-hand sides spent on refining Z alone (gbs.extrapolated_step's aux_evals):
-        not in the work count, which stays that of the integration without Z."""
+        """Right-hand sides spent on refining Z alone (gbs.extrapolated_step's aux_evals),
+        counted into the segment's work like every other right-hand side."""
 
     def rhs(self, u: float, y: list[float]) -> list[float]:
         """d/du of (theta, theta', I_n, J_x, J_y, I_e, Z_x, Z_y) at local time u (s), with
@@ -210,11 +210,12 @@ class Sliding:
             cut = step < H  # cut short by the segment's end: accept from any column
             f0 = self.rhs(u, y)
             scale = self._step_scale(rates, step, y)
+            aux0 = self.aux_evals[0]
             y_new, err, k, nfev = gbs.extrapolated_step(
                 self.midpoint_sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN,
                 aux_scale=self._aux_scale(step, y), aux_evals=self.aux_evals,
             )
-            tally.work += nfev + GBS_STEP_WORK
+            tally.work += nfev + GBS_STEP_WORK + (self.aux_evals[0] - aux0)
             if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
                 H = gbs.next_step_size(step, err, k) if err == err else 0.1 * step
                 continue
@@ -281,11 +282,12 @@ class Sliding:
         s_v = abs(wf.wr) + abs(y[1]) + wf.omega_ref(y[1])  # rate scale, 1/s
 
         def at(x: float) -> tuple[list[float], float]:
+            aux0 = self.aux_evals[0]
             yx, _, _, nfev = gbs.extrapolated_step(
                 self.midpoint_sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4),
                 aux_scale=self._aux_scale(x, y), aux_evals=self.aux_evals,
             )
-            tally.work += nfev + GBS_STEP_WORK
+            tally.work += nfev + GBS_STEP_WORK + (self.aux_evals[0] - aux0)
             gn, sv = self.events(yx, u + x)
             return yx, min(gn / s_n, sv / s_v)
 
