@@ -47,7 +47,10 @@ step-averaged P/h at 1e-5 s or the cumulative E_diss is many units large and rou
 relative to it; other final-state values relative; ``inf`` where a value is missing,
 non-finite or not a number on one side (e.g. the sliding step memo ``H``). Exit 0 iff all
 jobs are identical; with ``--allow-rounding`` iff every difference is <= 1e-13 scaled with
-equal counts, modes and statuses (work counters may differ).
+equal counts, modes and statuses (work counters may differ). An FMU output the head adds
+(T_imb) is reported as "adds ..." and the job compared on the base's columns, the head's
+saved state without it; a removed output is a difference. The saved state's schema
+bookkeeping (versions; J and the adapter's spin when null) is not compared.
 
 ``--amplification`` measures, per scene on the current tree at 1e-3 s, how much a 1e-12
 scaled perturbation of the initial state (+-x, +-y in c_r, +-vx, +-vy in c_r |Omega|) grows:
@@ -744,6 +747,7 @@ class Verdict:
         self.modes_equal = True
         self.status_equal = True
         self.error = ""
+        self.added: list[str] = []  # outputs the head records beyond the base's
 
     def note(self, at: float, what: str) -> None:
         """Keep the earliest difference (ties: the first noted)."""
@@ -891,17 +895,35 @@ def compare_job(job: tuple[str, str, str], ra: dict[str, Any], rb: dict[str, Any
         return v
     units = scales(spec)
     name = job_name(*job)
-    if ra["columns"] != rb["columns"]:
-        v.note(-1.0, "recorded columns differ (FMU variables?)")
-        v.max_scaled = math.inf
-    else:
-        for ext, cols, label in zip(("rows", "imp", "tr"), ra["columns"],
-                                    ("step", "impact", "transition")):
-            compare_tables(v, load_table(wa, name, ext, len(cols)),
-                           load_table(wb, name, ext, len(cols)), list(cols), units, label)
+    added: set[str] = set()
+    for ext, ca, cb, label in zip(("rows", "imp", "tr"), ra["columns"], rb["columns"],
+                                  ("step", "impact", "transition")):
+        if not set(ca) <= set(cb):
+            v.note(-1.0, f"recorded {label} columns removed: {sorted(set(ca) - set(cb))}")
+            v.max_scaled = math.inf
+            continue
+        added |= set(cb) - set(ca)  # a new output: compared on the base's columns
+        tb = load_table(wb, name, ext, len(cb))[:, [list(cb).index(c) for c in ca]]
+        compare_tables(v, load_table(wa, name, ext, len(ca)), tb, list(ca), units, label)
+    v.added = sorted(added)
     compare_final(v, ra["counters"], rb["counters"], units, "counter")
-    compare_final(v, ra["state"], rb["state"], units, "state")
+    compare_final(v, ra["state"], _without_keys(rb["state"], added), units, "state")
+    if added and not v.first:  # identical on everything the base recorded
+        v.identical = True
+        v.first = f"adds {', '.join(v.added)}"
     return v
+
+
+def _without_keys(value: Any, names: set[str]) -> Any:
+    """value with every dict key in names removed, recursively (an added output's value
+    in the head's saved FMU state)."""
+    if not names:
+        return value
+    if isinstance(value, dict):
+        return {k: _without_keys(x, names) for k, x in value.items() if k not in names}
+    if isinstance(value, list):
+        return [_without_keys(x, names) for x in value]
+    return value
 
 
 # ------------------------------------------------------------------------------ report
