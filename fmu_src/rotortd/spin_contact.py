@@ -100,6 +100,9 @@ class SpinSegmentEnd:
     work: int
 
 
+_NAN6 = (math.nan,) * 6
+
+
 class ContactModel:
     """The held inputs as plain floats, and the contact's forces at a state in real
     arithmetic (SI; one cos/sin pair each for theta and psi + phi)."""
@@ -135,8 +138,11 @@ class ContactModel:
     def sliding(self, s: float, theta: float, dtheta: float, psi: float, Omega: float
                 ) -> tuple[float, float, float, float, float, float]:
         """(N, F_t, theta'', Omega', cos theta, sin theta) of sliding with slip sign s."""
-        ct, st = math.cos(theta), math.sin(theta)
-        B, A, rn, Fot, T, cb = self._known(ct, st, dtheta, psi, Omega)
+        try:
+            ct, st = math.cos(theta), math.sin(theta)
+            B, A, rn, Fot, T, cb = self._known(ct, st, dtheta, psi, Omega)
+        except ValueError:  # an angle overflowed to inf in a trial step: NaN rejects it
+            return _NAN6
         m, mus = self.m, self.mu * s
         k = B + mus * A
         dW = (T - k * rn) / (self.J + m * B * k)
@@ -147,8 +153,11 @@ class ContactModel:
     def rolling(self, theta: float, psi: float, Omega: float
                 ) -> tuple[float, float, float, float, float, float]:
         """(N, F_t, theta'', Omega', cos theta, sin theta) of rolling (theta' = -R Omega/c_r)."""
-        ct, st = math.cos(theta), math.sin(theta)
-        B, A, rn, Fot, T, _ = self._known(ct, st, -self.R * Omega / self.c_r, psi, Omega)
+        try:
+            ct, st = math.cos(theta), math.sin(theta)
+            B, A, rn, Fot, T, _ = self._known(ct, st, -self.R * Omega / self.c_r, psi, Omega)
+        except ValueError:  # as in sliding
+            return _NAN6
         m = self.m
         dW = (T - B * rn - A * Fot) / (self.J + m * (A * A + B * B))
         return rn + m * B * dW, Fot + m * A * dW, -self.R * dW / self.c_r, dW, ct, st
