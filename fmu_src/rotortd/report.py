@@ -132,3 +132,15 @@ def work_cap(*_args: object) -> int:
 
 _SEGMENT_NAMES = {MODE_FREE: "free flight", MODE_SLIDING: "sliding", MODE_ROLLING: "rolling"}
 _PROVED_FREE, _RUB = "proved free flight", "rub in closed form"  # _whole_step's choices
+
+
+def stop_at_work_bound(rep: StepReport, st: StepContext, exc: Exception, t0: float, s: float,
+                       h: float, where: str) -> None:
+    """Record in ``rep`` that the step stopped at its work bound: STATUS_WORK_CAP and a
+    message saying where (t0 the step's start, s how far into the step of h it got, in s;
+    ``where`` names the segment). The exception's own work joins the step's count."""
+    work = st.work
+    work.iters += getattr(exc, "work", 0)
+    rep.status, rep.message = STATUS_WORK_CAP, (
+        f"work bound reached: {work.total} > {st.cap} work units; the core stopped at "
+        f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in {where}: {exc}")

@@ -38,6 +38,7 @@ from .report import (
     StepContext,
     StepReport,
     WorkCapExceeded,
+    stop_at_work_bound,
     work_cap,
 )
 from .rub import RubEquilibrium
@@ -309,12 +310,9 @@ class TouchdownCore(FlightSteps, ContactSteps):
                     if s == s_before and MODE_FREE in (mode, self._mode):
                         st.sticky_at = s  # N = 0 to rounding: contact holds past it
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
-            work.iters += getattr(exc, "work", 0)
-            rep.status, rep.message = STATUS_WORK_CAP, (
-                f"work bound reached: {work.total} > {cap} work units; the core stopped at "
-                f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
+            stop_at_work_bound(rep, st, exc, t0, s, h, (
                 f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
-                f"{len(rep.impacts)} impacts in the step): {exc}")
+                f"{len(rep.impacts)} impacts in the step)"))
         rep.work = work.total
         if not st.imb_whole:
             self._imb_close(rep, start, s)

@@ -34,10 +34,10 @@ from .report import (
     MODE_FREE,
     MODE_ROLLING,
     MODE_SLIDING,
-    STATUS_WORK_CAP,
     StepContext,
     StepReport,
     WorkCapExceeded,
+    stop_at_work_bound,
 )
 from .rigid import Delassus, check_well_posed, spin_impact
 from .simulator import TouchdownCore
@@ -157,12 +157,9 @@ class SpinCore(TouchdownCore):
                 if self._mode != mode:
                     rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
-            work.iters += getattr(exc, "work", 0)
-            rep.status, rep.message = STATUS_WORK_CAP, (
-                f"work bound reached: {work.total} > {cap} work units; the core stopped at "
-                f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in "
+            stop_at_work_bound(rep, st, exc, t0, s, h, (
                 f"{_SEGMENT_NAMES[self._mode]} with the spin as a state "
-                f"({len(rep.impacts)} impacts in the step): {exc}")
+                f"({len(rep.impacts)} impacts in the step)"))
         rep.work = work.total
         return s
 
