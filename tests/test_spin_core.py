@@ -12,7 +12,7 @@ import json
 import math
 
 import pytest
-from rotortd import MODE_ROLLING, STATUS_OK, CrossParameterError, RotorParams
+from rotortd import MODE_ROLLING, MODE_SLIDING, STATUS_OK, CrossParameterError, RotorParams
 from rotortd.spin_core import SpinCore, restore_core
 
 CHAPTER_G = RotorParams(g=9.81)
@@ -136,3 +136,25 @@ def test_infinite_inertia_limit_is_the_held_speed_core() -> None:
     assert abs(spin.z - held.z) <= 1e-5 * p.c_r
     assert spin.Omega == pytest.approx(184.2, rel=1e-6)
     assert math.isfinite(spin.E_diss)
+
+
+def test_energy_balance_closes_with_the_bearing_on() -> None:
+    """The bearing on without its damper (c = 0: the spring k and the bias force store
+    energy, V = a k |z|^2/2 - a Re(conj(F_bias) z) + m g Im(z_G)), a drive of 5 N m, from
+    rest at the centre: the imbalance drives the rotor into impacts and sliding, the flight
+    integrated (Taylor). T + V changes by the drive's work minus the dissipation, to below
+    1e-10 of the sum of the terms' magnitudes."""
+    p = RotorParams(g=9.81, c=0.0)
+    core = SpinCore(p, J_HALF, 0j, 0j, 0.0, 184.2)
+
+    def stored() -> float:
+        zG = core.z + p.e_c * cmath.exp(1j * (core.psi + p.phi))
+        return (0.5 * p.k * abs(core.z) ** 2 - (p.bias_force.conjugate() * core.z).real
+                + p.m * p.g * zG.imag)
+
+    b0, V0 = _body(core), stored()
+    modes = _run(core, 1e-4, 2000, amb_on=1.0, T_drive=5.0)
+    b1 = _body(core)
+    terms = [b1["T"] - b0["T"], stored() - V0, -5.0 * (b1["psi"] - b0["psi"]), core.E_diss]
+    assert core.n_impacts > 100 and MODE_SLIDING in modes
+    assert abs(sum(terms)) <= 1e-10 * sum(abs(x) for x in terms)
