@@ -317,3 +317,19 @@ def test_spin_state_reports_the_same_torque_from_its_balance() -> None:
     assert abs(b.T_imb - a.T_imb) <= 1e-6 * abs(a.T_imb)
     assert b.T_f == 0.0
     assert 0.04 * (spin.Omega - W0) == pytest.approx((3.0 + b.T_imb) * 1e-5, rel=1e-12)
+
+
+def test_state_round_trip_keeps_the_torque_bit_for_bit() -> None:
+    """The proved-free closed form of T_imb has two roundings (from a flight's ends, or from
+    coefficients once a step length recurs); which one the next flight takes is part of the
+    state, so a restored core reports the same bits (FMU fuzz case 256 found it)."""
+    import json
+
+    from rotortd import restore_core
+
+    core = TouchdownCore.on_steady_whirl(RotorParams(), W0)
+    for _ in range(40):
+        core.step(1e-3, W0)
+        saved = json.loads(json.dumps(core.get_state()))
+        a, b = core.step(1e-3, W0), restore_core(saved).step(1e-3, W0)
+        assert (a.T_imb, a.P_imb) == (b.T_imb, b.P_imb)

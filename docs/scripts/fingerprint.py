@@ -847,13 +847,21 @@ NULL_WHEN_HELD = ("J", "spin")
 J since rotortd-state 2, the adapter's spin until rotortd-fmu-state 1): left out when null."""
 
 
+CACHE_KEYS = ("imb_h",)
+"""State entries that record a cache's choice between two roundings (the imbalance torque's
+proved-free closed form), new in rotortd-state 2: not compared."""
+
+
 def physics_leaves(value: Any) -> dict[str, Any]:
-    """``flatten(value)`` without the schema's bookkeeping (SCHEMA_LEAVES, and the
-    NULL_WHEN_HELD leaves when null), so that a schema version bump compares equal."""
+    """``flatten(value)`` without the schema's bookkeeping (SCHEMA_LEAVES, the
+    NULL_WHEN_HELD leaves when null, CACHE_KEYS), so that a schema version bump compares
+    equal."""
     out = {}
     for key, x in flatten(value).items():
-        last = key.rsplit(".", 1)[-1]
-        if last in SCHEMA_LEAVES or (last in NULL_WHEN_HELD and x is None):
+        parts = key.split(".")
+        last = parts[-1]
+        if (last in SCHEMA_LEAVES or (last in NULL_WHEN_HELD and x is None)
+                or any(c in parts for c in CACHE_KEYS)):
             continue
         out[key] = x
     return out

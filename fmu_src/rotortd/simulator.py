@@ -441,6 +441,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
             slip=self._slip, locked=self._locked, on_wall=self._on_wall,
             n_impacts=self._n_impacts, t_last=self._t_last, v_last=self._v_last,
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
+            imb_h=(self._imb_seen_h, self._imb_free_h),
             inputs=self._inputs,
         )
 
@@ -473,3 +474,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         self._E_diss = cs.E_diss
         self._t_contact = cs.t_contact
         self._slide_step = cs.slide_step
+        self._imb_seen_h = cs.imb_h[0]  # the imbalance closed form's choice continues
+        if not math.isnan(cs.imb_h[1]):  # (its coefficients: the same bits again)
+            c = self._fm.imb_impulse(cs.imb_h[1])
+            self._imb_free_h, self._imb_free = cs.imb_h[1], (c.bz, c.bv, c.b0, c.bE.imag)

@@ -62,6 +62,9 @@ class CoreState:
     a state (J set), Omega is the spin speed at t."""
     J: float | None = None
     """Polar inertia about the mass centre (kg m^2) when the spin is a state, else None."""
+    imb_h: tuple[float, float] = (math.nan, math.nan)
+    """Step lengths (s) the imbalance torque's proved-free closed form has seen once and
+    holds coefficients for (NaN: none): which of its two roundings the next flight takes."""
 
     def to_json(self) -> dict:
         """The JSON-serialisable dict of schema ``rotortd-state``, version STATE_VERSION."""
@@ -90,6 +93,7 @@ class CoreState:
             "H": None if math.isinf(self.slide_step) else self.slide_step,
             "inputs": [W, F.real, F.imag, a],
             "J": self.J,
+            "imb_h": [None if math.isnan(x) else x for x in self.imb_h],
         }
 
     @classmethod
@@ -103,6 +107,8 @@ class CoreState:
                 f"{' or '.join(map(str, READABLE_VERSIONS))}"
             )
         J = st.get("J") if st["version"] >= 2 else None
+        imb_h = tuple(math.nan if x is None else float(x)
+                      for x in st.get("imb_h", (None, None)))
         W, fx, fy, a = st["inputs"]
         return cls(
             params=RotorParams(**st["params"]),
@@ -126,4 +132,5 @@ class CoreState:
             slide_step=math.inf if st["H"] is None else float(st["H"]),
             inputs=(float(W), complex(fx, fy), float(a)),
             J=None if J is None else float(J),
+            imb_h=(imb_h[0], imb_h[1]),
         )

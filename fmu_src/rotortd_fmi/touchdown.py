@@ -215,7 +215,12 @@ class RotorTouchdownAdapter(GuardedSlave):
                    if not _same(float(getattr(self, n)), getattr(params, n))}
         if changes:
             self._require_ranges(tuple(changes))
-            self._core.set_params(params.replace(**changes))
+            import rotortd
+
+            try:
+                self._core.set_params(params.replace(**changes))
+            except rotortd.CrossParameterError as exc:  # (J with new mu, e_c: ill posed)
+                raise ModelError(f"cross-parameter constraint: {exc}") from exc
 
     def _check_changes(self) -> None:
         """Validate fixed parameters, tunables and inputs, each only when its values
