@@ -99,6 +99,40 @@ def test_reference_converges() -> None:
             assert abs(ref[k] - fine[k]) <= 1e-30 * scale, (name, key)
 
 
+def _kinematics(th: Any, dth: Any, psi: Any, Om: Any) -> tuple[Any, Any, Any]:
+    """(z, z_G, z_G') on the circle (mpmath)."""
+    n = mpmath.expj(th)
+    E = mpmath.expj(psi + CHAPTER["phi"])
+    z = CR * n
+    return z, z + CHAPTER["e_c"] * E, 1j * CR * dth * n + 1j * CHAPTER["e_c"] * Om * E
+
+
+@pytest.mark.parametrize("name", [k for k, c in CASES.items() if c[6] == 0.0])
+def test_reference_balances(name: str) -> None:
+    """The reference's own physics, bearing off: the energy balance (kinetic + gravity +
+    the potential of the held F_ext, minus the drive's work T_drive dpsi, plus the friction
+    dissipation: zero; rolling dissipates nothing) and the momentum balance
+    m dz_G' = (F_ext - i m g) t + int F_c, each to 1e-30 of its terms."""
+    s, th, dth, psi, Om, _, _, F_ext, T_drive, _ = CASES[name]
+    ref = mp_segment(name)
+    with mpmath.workdps(50):
+        m, g, T_drive = (mpmath.mpf(x) for x in (CHAPTER["m"], CHAPTER["g"], T_drive))
+        F_ext = mpmath.mpc(F_ext)
+        if s == 0:
+            dth = -mpmath.mpf(R) * Om / CR
+        z0, zg0, vg0 = _kinematics(*(mpmath.mpf(x) for x in (th, dth, psi, Om)))
+        z1, zg1, vg1 = _kinematics(ref["theta"], ref["dtheta"], ref["psi"], ref["Omega"])
+        terms = [m * abs(vg1) ** 2 / 2, -m * abs(vg0) ** 2 / 2,
+                 J * ref["Omega"] ** 2 / 2, -J * mpmath.mpf(Om) ** 2 / 2,
+                 m * g * mpmath.im(zg1 - zg0), -mpmath.re(mpmath.conj(F_ext) * (z1 - z0)),
+                 -T_drive * (ref["psi"] - psi), ref["E_diss"]]
+        assert abs(mpmath.fsum(terms)) <= 1e-30 * mpmath.fsum(abs(x) for x in terms)
+        mom = [m * (vg1 - vg0), -(F_ext - 1j * m * g) * ref["t"], -ref["P_c"]]
+        assert abs(mpmath.fsum(mom)) <= 1e-30 * mpmath.fsum(abs(x) for x in mom)
+        if s == 0:
+            assert ref["E_diss"] == 0
+
+
 @pytest.mark.parametrize("name", SEGMENTS)
 def test_segment_matches_mp(name: str) -> None:
     end, ref = core_segment(name), mp_segment(name)
