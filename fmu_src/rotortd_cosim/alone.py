@@ -19,15 +19,13 @@ Units: SI (s, rad/s, N, N m).
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 import time
-import traceback
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .run import exit_after
 from .scenes import ALL_SCENES, Scene
 
 Result = dict[str, np.ndarray]
@@ -150,11 +148,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    try:
-        code = main()
-    except Exception:
-        traceback.print_exc()
-        code = 1
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
+    exit_after(main)

@@ -13,6 +13,7 @@ import os
 import sys
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +37,9 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-if __name__ == "__main__":
+def exit_after(main: Callable[[], int]) -> None:
+    """Run an engine subprocess's ``main`` and leave with os._exit (PythonFMU FMUs share the
+    interpreter and can crash it at a normal exit): its exit code, 1 on an exception."""
     try:
         code = main()
     except Exception:
@@ -45,3 +48,7 @@ if __name__ == "__main__":
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(code)
+
+
+if __name__ == "__main__":
+    exit_after(main)
