@@ -84,7 +84,7 @@ class FlightSteps:
         closed form, FlightModel.imb_impulse; its coefficients are computed once the
         length recurs under the same flight model, and kept on the core for the next such
         flight (forgotten with the flight model, _set_inputs); a first flight of a length,
-        as each spin sub-step of SpinCoupler is, takes FlightModel.imb_impulse_ends."""
+        as when the held inputs change every step, takes FlightModel.imb_impulse_ends."""
         fm = self._fm
         if self._imb_free_h != h:
             if self._imb_seen_h != h:
