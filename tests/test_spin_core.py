@@ -185,3 +185,17 @@ def test_energy_balance_closes_with_the_damper() -> None:
              damper]
     assert core.n_impacts == 0 and core.mode == MODE_SLIDING and damper > 0.01
     assert abs(sum(terms)) <= 1e-10 * sum(abs(x) for x in terms)
+
+
+@pytest.mark.parametrize("W", [0.0, 1e-9, 10.0])
+@pytest.mark.parametrize("theta", [0.0, math.pi, 0.3])
+def test_at_rest_on_the_wall_under_gravity(W: float, theta: float) -> None:
+    """At rest on the wall with gravity along the wall (theta = 0, pi): the normal force is
+    zero to rounding, the flight touches at once and the contact may refuse it. The tie is
+    broken (contact within N's rounding band) instead of zero-length flights until the work
+    bound (theta = pi with Omega = 1e-9 stalled so); elsewhere the rotor leaves the wall."""
+    p = RotorParams(g=9.81)
+    core = SpinCore(p, J_HALF, p.c_r * cmath.exp(1j * theta), 0j, 0.0, W)
+    rep = core.step(1e-3, amb_on=0.0)
+    assert rep.status == STATUS_OK and rep.work < 10_000 and core.t == pytest.approx(1e-3)
+    assert abs(core.z) <= p.c_r * (1 + 1e-12)

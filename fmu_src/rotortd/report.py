@@ -101,8 +101,8 @@ class StepContext:
     never stored on the core: its work and work bound, the rounding error of its local
     time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
 
-    __slots__ = ("cap", "first", "imb_whole", "roll_lenient", "rub_refused", "s_lo",
-                 "sticky_at", "work")
+    __slots__ = ("cap", "first", "imb_whole", "n_slack", "roll_lenient", "rub_refused",
+                 "s_lo", "sticky_at", "work")
 
     def __init__(self, cap: int, rub_refused: bool = False) -> None:
         self.work = Work()
@@ -110,6 +110,7 @@ class StepContext:
         self.s_lo = 0.0  # rounding error of the step-local time (later), s
         self.roll_lenient = False  # zero slip proved stuck (_transition)
         self.sticky_at = math.nan  # where flight and contact swapped at N = 0
+        self.n_slack = 0.0  # SpinCore: lift-off only below -n_slack (N), after sticky_at
         self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
         self.first = True  # in the step's first segment (the step loop clears it)
         self.imb_whole = False  # P_imb of the whole step in closed form (_advance_free)

@@ -135,6 +135,16 @@ class ContactModel:
         return (e_c * sb, self.R - e_c * cb, Gr * ct + Gi * st + m * c_r * dtheta * dtheta,
                 Gi * ct - Gr * st, T, cb)
 
+    def normal_tol(self, theta: float, dtheta: float, psi: float, Omega: float) -> float:
+        """The rounding band of N (N): 64 eps times the magnitudes of its terms."""
+        ct, st = math.cos(theta), math.sin(theta)
+        _, A, _, _, T, _ = self._known(ct, st, dtheta, psi, Omega)
+        m = self.m
+        scale = (abs(self.fx) + abs(self.fy) + self.mg + (self.ac * abs(dtheta) + self.ak)
+                 * self.c_r + m * self.e_c * Omega * Omega + m * self.c_r * dtheta * dtheta
+                 + abs(T) / max(abs(A), 1e-300))
+        return 64.0 * 2.220446049250313e-16 * scale
+
     def sliding(self, s: float, theta: float, dtheta: float, psi: float, Omega: float
                 ) -> tuple[float, float, float, float, float, float]:
         """(N, F_t, theta'', Omega', cos theta, sin theta) of sliding with slip sign s."""
@@ -179,8 +189,9 @@ class SpinContact:
     (theta, theta', psi, Omega); in rolling theta' = -R Omega/c_r is implied."""
 
     def __init__(self, h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
-                 Omega: float, step0: float = math.inf) -> None:
+                 Omega: float, step0: float = math.inf, n_slack: float = 0.0) -> None:
         self.h, self.s = h, s
+        self.n_slack = n_slack  # N (N): lift-off only once N < -n_slack
         self.model = ContactModel(h)
         p = h.p
         self.dth_per_W = -p.R / p.c_r
@@ -223,9 +234,10 @@ class SpinContact:
         and in rolling mu N - |F_t| (slip start), in sliding s v_rel (slip zero)."""
         N, Ft = self._forces(y)[:2]
         if self.rolling:
-            return [("lift_off", N), ("slip_start", self.model.mu * N - abs(Ft))]
+            return [("lift_off", N + self.n_slack),
+                    ("slip_start", self.model.mu * N - abs(Ft))]
         vrel = self.model.R * y[3] + self.model.c_r * y[1]
-        return [("lift_off", N), ("slip_zero", vrel * self.s)]
+        return [("lift_off", N + self.n_slack), ("slip_zero", vrel * self.s)]
 
     def _margin(self, y: Vector) -> float:
         """The least event function (continuous; its first zero is the first event)."""

@@ -43,6 +43,7 @@ from .rigid import Delassus, check_well_posed, spin_impact
 from .simulator import TouchdownCore
 from .spin_contact import (
     ContactForces,
+    ContactModel,
     HeldInputs,
     SpinContact,
     rolling_forces,
@@ -182,27 +183,32 @@ class SpinCore(TouchdownCore):
         self._set_spin(fl.Omega)
         if fl.event is None:
             return h
-        s = st.later(s, min(fl.duration, rem))
-        self._at_wall(t0 + s + st.s_lo, held, rep)
-        return s
+        s_wall = st.later(s, min(fl.duration, rem))
+        sticky = s_wall == s == st.sticky_at  # a second zero-length flight here
+        if not self._at_wall(t0 + s_wall + st.s_lo, held, rep, st, sticky):
+            st.sticky_at = s_wall  # touched, but no contact force: flight again
+        return s_wall
 
     def _set_spin(self, W: float) -> None:
         self._inputs = (W, *self._inputs[1:])
 
-    def _at_wall(self, t: float, held: HeldInputs, rep: StepReport) -> None:
+    def _at_wall(self, t: float, held: HeldInputs, rep: StepReport, st: StepContext,
+                 sticky: bool) -> bool:
         """The flight reached the wall at t (s): an impact if it moves outward, then
-        contact if the low-speed rule says so or it touched with zero normal speed."""
+        contact if the low-speed rule says so or it touched with zero normal speed. False
+        when it touched and contact was refused (no positive normal force): the flight
+        goes on. ``sticky``: the flight touched again at once at the same time, so the
+        normal force is zero to its rounding band; contact is taken with that slack."""
         p = self._p
         z = self._z * (p.c_r / abs(self._z))
         n = z / p.c_r
         w = n.conjugate() * self._v
         if w.real > 0.0:
-            plastic = self._spin_impact(t, z, n, w.real, w.imag, held, rep)
-        else:
-            self._z = z
-            plastic = True
-        if plastic:
-            self._enter_spin_contact(held)
+            if self._spin_impact(t, z, n, w.real, w.imag, held, rep):
+                self._enter_spin_contact(held, st, False)
+            return True
+        self._z = z
+        return self._enter_spin_contact(held, st, sticky)
 
     def _spin_impact(self, t: float, z: complex, n: complex, rdot: float, vt: float,
                      held: HeldInputs, rep: StepReport) -> bool:
@@ -258,27 +264,35 @@ class SpinCore(TouchdownCore):
             return rolling_forces(held, self._theta, self._psi, W)
         return sliding_forces(held, s, self._theta, self._dtheta, self._psi, W)
 
-    def _enter_spin_contact(self, held: HeldInputs) -> None:
+    def _enter_spin_contact(self, held: HeldInputs, st: StepContext, sticky: bool) -> bool:
         """Enter sustained contact from the wall state (z, v): rolling where the slip is
-        zero and rolling holds, else sliding; stay in flight if the normal force is not
-        positive."""
+        zero and rolling holds, else sliding; stay in flight (False) if the normal force
+        is not positive, or with ``sticky`` not above minus its rounding band (then the
+        contact segment lifts off only below that band, StepContext.n_slack)."""
         p = self._p
         z, v = self._z, self._v
         n = z / abs(z)
         self._theta = cmath.phase(n)
         self._dtheta = (n.conjugate() * v).imag / p.c_r
-        mode, s = self._contact_mode(held, p.R * self._inputs[0] + p.c_r * self._dtheta)
+        slack = (ContactModel(held).normal_tol(self._theta, self._dtheta, self._psi,
+                                               self._inputs[0]) if sticky else 0.0)
+        mode, s = self._contact_mode(held, p.R * self._inputs[0] + p.c_r * self._dtheta,
+                                     -slack)
         if mode == MODE_FREE:
             self._on_wall = True
-            return
+            return False
         self._mode, self._slip = mode, s
+        st.n_slack = slack
+        return True
 
-    def _contact_mode(self, held: HeldInputs, vrel: float) -> tuple[int, float]:
-        """(mode, slip sign) of the contact at the current (theta, theta', psi, Omega)."""
+    def _contact_mode(self, held: HeldInputs, vrel: float, n_min: float = 0.0
+                      ) -> tuple[int, float]:
+        """(mode, slip sign) of the contact at the current (theta, theta', psi, Omega);
+        MODE_FREE when the normal force is not above n_min (N)."""
         p = self._p
         if vrel == 0.0:
             f = self._contact_forces(held, 0.0)
-            if f.N <= 0.0:
+            if n_min >= f.N:
                 return MODE_FREE, 0.0
             if abs(f.F_t) <= p.mu * f.N:
                 return MODE_ROLLING, 0.0
@@ -286,7 +300,7 @@ class SpinCore(TouchdownCore):
         else:
             s = 1.0 if vrel > 0.0 else -1.0
         f = self._contact_forces(held, s)
-        return (MODE_SLIDING, s) if f.N > 0.0 else (MODE_FREE, 0.0)
+        return (MODE_SLIDING, s) if n_min < f.N else (MODE_FREE, 0.0)
 
     def _spin_contact(self, s: float, h: float, t0: float, held: HeldInputs,
                       rep: StepReport, st: StepContext) -> float:
@@ -294,7 +308,7 @@ class SpinCore(TouchdownCore):
         rem = (h - s) - st.s_lo
         slip = 0.0 if self._mode == MODE_ROLLING else self._slip
         seg = SpinContact(held, slip, self._theta, self._dtheta, self._psi, self._inputs[0],
-                          self._slide_step)
+                          self._slide_step, st.n_slack if s == st.sticky_at else 0.0)
         end = seg.run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         self._slide_step = seg.next_step
