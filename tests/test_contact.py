@@ -342,7 +342,7 @@ def test_sliding_impulses_match_high_precision(case: str, h: float) -> None:
     I_c, I_n, T = 0j, 0.0, 0.01
     for _ in range(round(T / h)):
         rep = core.step(h, W0, F, amb)
-        assert rep.status == 0 and rep.mode == MODE_SLIDING
+        assert rep.status == 0 and core.mode == MODE_SLIDING
         I_c += rep.F_contact * h
         I_n += rep.F_n * h
     ref = mp_sliding(_par(core.params), th0, w0, psi0, W0, F, amb, T, dps=30)

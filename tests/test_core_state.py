@@ -17,14 +17,18 @@ def test_restore_reproduces_run_bit_for_bit(gamma: float) -> None:
     for _ in range(300):
         core.step(1e-3, W0)
     saved = json.loads(json.dumps(core.get_state()))
-    ref = [core.step(1e-3, W0) for _ in range(400)]
+    ref = [_step_row(core) for _ in range(400)]
     twin = TouchdownCore(RotorParams())
     twin.set_state(saved)
-    again = [twin.step(1e-3, W0) for _ in range(400)]
+    again = [_step_row(twin) for _ in range(400)]
     assert twin.get_state() == core.get_state()
-    assert [(r.F_contact, r.T_f, r.mode, len(r.impacts)) for r in ref] == [
-        (r.F_contact, r.T_f, r.mode, len(r.impacts)) for r in again
-    ]
+    assert ref == again
+
+
+def _step_row(core: TouchdownCore) -> tuple:
+    """A step's report (contact force, friction torque, impacts) and the mode after it."""
+    r = core.step(1e-3, W0)
+    return r.F_contact, r.T_f, core.mode, len(r.impacts)
 
 
 def test_foreign_state_is_refused() -> None:

@@ -8,7 +8,8 @@ Proof for issue 16 ("behaviour stays exactly as it is"). Every job, a scene run 
 communication step, is recorded to the last bit:
 
 - per step: the core's time, position, velocity and spin angle after the step and the step
-  report (F_contact, F_n, F_n_peak, P_n, T_f, E_diss, mode, status, message, work, work_cap,
+  report (F_contact, F_n, F_n_peak, P_n, T_f, E_diss, mode (the core's where the report has
+  none), status, message, work, work_cap,
   number of impacts and transitions) and the cumulative counters (n_impacts, E_diss,
   t_last_impact, v_last_impact, mode); every impact (t, z, v-, v+, rdot, P_n, P_t, stick,
   E_diss) and transition (t, name) in an event list; all as IEEE doubles, hashed (sha256)
@@ -314,7 +315,8 @@ def core_row(core: Any, rep: Any, h: float) -> list[float]:
     vx, vy = _cplx(g(core, "v", NAN))
     return [_num(g(core, "t", NAN)), x, y, vx, vy, _num(g(core, "psi", NAN)), h, fx, fy,
             _num(g(rep, "F_n", NAN)), _num(g(rep, "F_n_peak", NAN)), _num(g(rep, "P_n", NAN)),
-            _num(g(rep, "T_f", NAN)), _num(g(rep, "E_diss", NAN)), _num(g(rep, "mode", NAN)),
+            _num(g(rep, "T_f", NAN)), _num(g(rep, "E_diss", NAN)),
+            _num(g(rep, "mode", g(core, "mode", NAN))),  # (the report's mode: core.mode)
             _num(g(rep, "status", NAN)), _crc(g(rep, "message", "")), _num(g(rep, "work", NAN)),
             _num(g(rep, "work_cap", NAN)), float(len(g(rep, "impacts", ()) or ())),
             float(len(g(rep, "transitions", ()) or ())), _num(g(core, "n_impacts", NAN)),
@@ -375,8 +377,8 @@ def core_counters(rotortd: Any, core: Any, spec: Spec) -> dict[str, Any]:
              "E_diss", "t_contact_entry")
     out = {n: getattr(core, n, None) for n in names}
     _t, _h, omega, _force, amb = schedule(spec, None)[-1]
-    kin = getattr(core, "kinematics_values", None)
-    out["kinematics_values"] = _try(lambda: list(kin(omega, amb))) if kin else None
+    kin = getattr(core, "kinematics", None)
+    out["kinematics"] = _try(lambda: list(kin(omega, amb))) if kin else None
     if spec["steady"]:
         out["steady_start"] = _try(lambda: _steady_start(rotortd, spec))
     return out

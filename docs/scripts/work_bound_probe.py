@@ -112,7 +112,7 @@ def run_scene(scene: dict, t_limit: float, verbose: bool = False) -> dict:
         total += dt
         steps.append([dt, work, rep.status, rep.message[:300]])
         if verbose:
-            print(f"step {i}: {dt:.4f} s work {work} status {rep.status} mode {rep.mode} "
+            print(f"step {i}: {dt:.4f} s work {work} status {rep.status} mode {core.mode} "
                   f"{rep.message[:200]}", flush=True)
         if rep.status != 0 or total > t_limit:
             break

@@ -101,7 +101,7 @@ class ContactSteps:
             seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step)
             end = seg.run(self._slide_span(rem), st.cap - st.work.total)
             self._slide_step = end.next_step
-        st.work.iters += end.tally.work
+        st.work.iters += end.work
         self._end_segment(end, rep, st, E)
         return st.later(s, end.duration) if end.duration < rem else h
 
@@ -114,8 +114,13 @@ class ContactSteps:
         rep.add_contact(end.tally, p.m * p.c_r, p.c_r)
         self._imb_add(rep, E, p.c_r * end.tally.I_z)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
-        self._advance_psi(end.duration)
+        self._advance_spin(end)
         self._transition(end.event, st)
+
+    def _advance_spin(self, end: SegmentEnd) -> None:
+        """The spin angle at a segment's end: advanced at the held speed (SpinCore: the
+        segment's own psi and Omega)."""
+        self._advance_psi(end.duration)
 
     def _rub_step(self, h: float, rep: StepReport) -> bool:
         """A sliding step on or near a stable forward rub in closed form, without the step
@@ -131,7 +136,7 @@ class ContactSteps:
             return False
         start = self._imb_start()  # (after a lock: its snap is not an impulse)
         end = rub.run(h)
-        rep.work = end.tally.work
+        rep.work = end.work
         self._end_segment(end, rep, None, E)
         self._imb_close(rep, start, h)
         return True

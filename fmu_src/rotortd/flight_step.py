@@ -29,11 +29,12 @@ import cmath
 import math
 from collections.abc import Callable
 
-from .events import ContactLocator, flight_is_clear
+from .events import ContactLocator, Work, flight_is_clear
 from .flight import FlightModel
 from .impact import Impact, reset
 from .report import StepContext, StepReport
 from .scaled import TWO_PI_HI, TWO_PI_LO
+from .wall import SegmentEnd
 
 ETA_HEIGHT = 1e-14
 """Rule (1): rebound height below ETA_HEIGHT c_r counts as contact."""
@@ -113,26 +114,26 @@ class FlightSteps:
 
     def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
                       st: StepContext) -> float:
-        fm = self._fm
-        work = st.work
+        """A flight segment from s seconds into the step: choose it (searched unless the
+        flight is proved clear), advance it (``Flight.run``), apply its end."""
         rem = (h - s) - st.s_lo
         E = self._phasor()
         if not self._clear and not self._on_wall and t0 + s >= self._envelope_at:
-            work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
-            self._check_envelope(fm, t0 + s, E)
-        hit = loc = None
-        if not self._clear:
-            loc = ContactLocator(fm, self._z, self._v, E)
-            hit = loc.find(rem, self._on_wall, work, st.cap - work.total)
-        if hit is None:
-            z0, v0 = self._z, self._v
-            if loc is not None and s > 0.0:
-                # the rest of a step after an event: a length that will not recur, whose
-                # flight map costs twelve times the search's modal state (measured)
-                self._z, self._v, _ = loc.state(rem, work)
-            else:  # a whole step: its length recurs and its flight map is cached
-                work.evals += 1
-                self._z, self._v = fm.propagate(self._z, self._v, E, rem, cache=(s == 0.0))
+            st.work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
+            self._check_envelope(self._fm, t0 + s, E)
+        seg = Flight(self._fm, self._z, self._v, E, self._on_wall, not self._clear, s > 0.0)
+        end = seg.run(rem, st.cap - st.work.total)
+        st.work.iters += end.work
+        return self._end_flight(end, seg, s, h, rem, t0, rep, st)
+
+    def _end_flight(self, end: SegmentEnd, seg: Flight, s: float, h: float, rem: float,
+                    t0: float, rep: StepReport, st: StepContext) -> float:
+        """Apply the end of a flight segment ``seg`` begun s seconds into the step (rem
+        seconds left): its state, its term of P_imb, and an impact or the entry into
+        contact at its event. Returns how far into the step it got (s)."""
+        fm, E, z0, v0 = self._fm, seg.E, seg.z0, seg.v0
+        if end.event is None:  # the rest of the step is free
+            self._z, self._v = end.z, end.v
             if st.first:  # the whole step in one flight: as a proved-free one (closed form)
                 rep.P_imb = self._imb_flight(z0, v0, E, rem)
                 st.imb_whole = True
@@ -141,22 +142,22 @@ class FlightSteps:
             self._advance_psi(rem)
             self._on_wall = False
             return h
-        ds = min(hit.s, rem)
-        if ds == hit.s:  # the flight's end is the hit's state
-            self._imb_add(rep, E, fm.imb_integral_ends(self._z, self._v, E, hit.z, hit.v, ds))
+        ds = min(end.duration, rem)
+        if ds == end.duration:  # the flight's end is the hit's state
+            self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, end.z, end.v, ds))
         else:
-            self._imb_add(rep, E, fm.imb_integral(self._z, self._v, E, ds))
+            self._imb_add(rep, E, fm.imb_integral(z0, v0, E, ds))
         self._advance_psi(ds)
-        if hit.kind == "clear":
-            self._z, self._v = hit.z, hit.v
+        if end.event == "clear":
+            self._z, self._v = end.z, end.v
             self._on_wall = False
             return st.later(s, ds)
-        z = hit.z * (self._p.c_r / abs(hit.z))
+        z = end.z * (self._p.c_r / abs(end.z))
         self._forget_clear_proof()
-        if hit.kind == "impact":
-            self._impact(t0 + s + (st.s_lo + ds), z, hit.v, rep)
+        if end.event == "impact":
+            self._impact(t0 + s + (st.s_lo + ds), z, end.v, rep)
         else:
-            self._z, self._v = z, hit.v
+            self._z, self._v = z, end.v
             self._enter_contact()
         return st.later(s, ds)
 
@@ -223,6 +224,40 @@ class FlightSteps:
 
         A = self._outward_accel(n, v_plus)
         return starts_contact(A, p.d * v, p.d, p.c_r, w_ref)
+
+
+class Flight:
+    """A free flight under the held inputs from (z0 (m), v0 (m/s), E0 = e^{i psi}): the
+    flight segment, ``run(rem, limit) -> SegmentEnd``. ``search``: look for the first
+    contact (False when the flight is proved clear of the wall for all time);
+    ``resumed``: the flight begins after an event inside the step, so its length will
+    not recur and it ends by the search's modal state instead of the cached flight map."""
+
+    __slots__ = ("E", "fm", "on_wall", "resumed", "search", "v0", "z0")
+
+    def __init__(self, fm: FlightModel, z0: complex, v0: complex, E: complex, on_wall: bool,
+                 search: bool, resumed: bool) -> None:
+        self.fm, self.z0, self.v0, self.E = fm, z0, v0, E
+        self.on_wall, self.search, self.resumed = on_wall, search, resumed
+
+    def run(self, rem: float, limit: int) -> SegmentEnd:
+        """Fly at most rem seconds; stop at the first contact ("impact", "touch"), or where
+        the search used its advances ("clear"); at most ``limit`` work units of search."""
+        fm, work = self.fm, Work()
+        loc = hit = None
+        if self.search:
+            loc = ContactLocator(fm, self.z0, self.v0, self.E)
+            hit = loc.find(rem, self.on_wall, work, limit)
+        if hit is not None:
+            return SegmentEnd(hit.s, event=hit.kind, z=hit.z, v=hit.v, work=work.total)
+        if loc is not None and self.resumed:
+            # the rest of a step after an event: a length that will not recur, whose
+            # flight map costs twelve times the search's modal state (measured)
+            z, v, _ = loc.state(rem, work)
+        else:  # a whole step: its length recurs and its flight map is cached
+            work.evals += 1
+            z, v = fm.propagate(self.z0, self.v0, self.E, rem, cache=not self.resumed)
+        return SegmentEnd(rem, z=z, v=v, work=work.total)
 
 
 def starts_contact(A: float, vb: float, d: float, c_r: float,

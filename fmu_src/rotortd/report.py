@@ -7,8 +7,9 @@ Frame and units: inertial, SI. ``StepReport`` is the step's one accumulator and 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from .events import WORK_MAX, Work
 from .impact import Impact
@@ -44,7 +45,6 @@ class StepReport:
     P_n: float = 0.0
     T_f: float = 0.0
     E_diss: float = 0.0
-    mode: int = MODE_FREE
     work: int = 0
     work_cap: int = 0
     transitions: list[tuple[float, str]] = field(default_factory=list)
@@ -96,13 +96,26 @@ class Kinematics(NamedTuple):
     F_amb_y: float
 
 
+N_KINEMATICS = len(Kinematics._fields)
+
+
+StateOutputs = namedtuple("StateOutputs", (
+    *Kinematics._fields, "Omega", "mode", "n_impacts", "t_last_impact", "v_last_impact",
+    "E_diss"))
+StateOutputs.__doc__ = """What the state shows (``TouchdownCore.outputs``): the ``Kinematics``
+fields, then the spin speed Omega (rad/s: the held input, or the state with the spin a
+state), the mode (0 free, 1 sliding, 2 rolling) and the counters n_impacts, t_last_impact
+(s), v_last_impact (m/s, the last impact's normal speed) and E_diss (J, dissipated so far).
+A named tuple: the fields unpack in this order."""
+
+
 class StepContext:
     """The context of a step taken segment by segment, passed down the step loop and
     never stored on the core: its work and work bound, the rounding error of its local
     time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
 
-    __slots__ = ("cap", "first", "imb_whole", "n_slack", "roll_lenient", "rub_refused",
-                 "s_lo", "sticky_at", "work")
+    __slots__ = ("cap", "first", "held", "imb_whole", "n_slack", "roll_lenient",
+                 "rub_refused", "s_lo", "sticky_at", "work")
 
     def __init__(self, cap: int, rub_refused: bool = False) -> None:
         self.work = Work()
@@ -114,6 +127,7 @@ class StepContext:
         self.rub_refused = rub_refused  # the start state is not near a rub (_rub_step)
         self.first = True  # in the step's first segment (the step loop clears it)
         self.imb_whole = False  # P_imb of the whole step in closed form (_advance_free)
+        self.held: Any = None  # SpinCore: the step's held inputs (spin_contact.HeldInputs)
 
     def later(self, s: float, ds: float) -> float:
         """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step

@@ -133,7 +133,7 @@ class Rolling:
                 x_end, kind = x, name
         self._integrate(tally, x_end)
         theta = wrap_angle(self.theta0 + self.dtheta * x_end)
-        return SegmentEnd(x_end, theta, self.dtheta, kind, tally)
+        return SegmentEnd(x_end, theta, self.dtheta, kind, tally, work=tally.work)
 
     def _integrate(self, tally: ContactTally, x: float) -> None:
         wf = self.wf

@@ -237,8 +237,7 @@ class LinearRub(_RubStep):
         tal.peak = eq.Gn + max(gx * x0 + gy * y0, gx * x1 + gy * y1)
         # theta - Omega u = theta0 - x0 + x: e^{ix} to first order, as the force's direction
         tal.I_z = e0 * complex(rem, int_x)
-        tal.work = 1
-        return SegmentEnd(rem, self.theta0 + W * rem + dx, W + y1, None, tal)
+        return SegmentEnd(rem, self.theta0 + W * rem + dx, W + y1, None, tal, work=1)
 
 
 QUAD_TOL = 1e-4
@@ -359,8 +358,7 @@ class QuadraticRub(_RubStep):
                             gx * x + gy * y + gxx * q[0] + q[2])
         # e^{ix} to second order: int (1 + i x - x^2/2), int x^2 = S1 to that order
         tal.I_z = e0 * complex(rem - 0.5 * S1.real, int_x)
-        tal.work = 1
-        return SegmentEnd(rem, self.theta0 + W * rem + (x - x0), W + y, None, tal)
+        return SegmentEnd(rem, self.theta0 + W * rem + (x - x0), W + y, None, tal, work=1)
 
 
 class LockedRub:
@@ -386,8 +384,7 @@ class LockedRub:
         tal.I_e = ft * (wf.wr + dtheta) * rem
         tal.peak = gn
         tal.I_z = e0 * phase_integral(dtheta - wf.Omega, rem)
-        tal.work = 1
-        return SegmentEnd(rem, theta + wf.Omega * rem, dtheta, None, tal)
+        return SegmentEnd(rem, theta + wf.Omega * rem, dtheta, None, tal, work=1)
 
 
 def _quadratic_drop(wf: WallForces, eq: RubEquilibrium, mus: float, X: float, Y: float,

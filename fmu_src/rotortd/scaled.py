@@ -125,12 +125,16 @@ def to_scaled(
 ) -> tuple[complex, complex]:
     """(U, U') scaled co-rotating of the inertial (z (m), z' (m/s)) at spin angle psi (rad).
 
-    U = z e^{-i psi}/c_r, U' = (z' - i Omega z) e^{-i psi}/(c_r Omega); U' = 0 when
-    Omega = 0 (undefined there). Same bits as ``TouchdownCore.kinematics_values``'s u and du.
+    U = z e^{-i psi}/c_r, U' = (z' - i Omega z) e^{-i psi}/(c_r Omega); U' = 0 where it is
+    undefined (Omega = 0) or overflows (|Omega| so small that c_r Omega underflows or the
+    quotient is not finite). ``TouchdownCore.outputs`` publishes these.
     """
     rot = cmath.exp(-1j * psi)
     zr = z * rot
-    dU = (v - 1j * Omega * z) * rot / (c_r * Omega) if Omega != 0.0 else 0j
+    den = c_r * Omega
+    dU = (v - 1j * Omega * z) * rot / den if den != 0.0 else 0j
+    if not (math.isfinite(dU.real) and math.isfinite(dU.imag)):
+        dU = 0j
     return complex(zr.real / c_r, zr.imag / c_r), dU
 
 

@@ -32,9 +32,11 @@ from .report import (
     MODE_FREE,
     MODE_ROLLING,
     MODE_SLIDING,
+    N_KINEMATICS,
     STATUS_OK,
     STATUS_WORK_CAP,
     Kinematics,
+    StateOutputs,
     StepContext,
     StepReport,
     WorkCapExceeded,
@@ -42,14 +44,14 @@ from .report import (
     work_cap,
 )
 from .rub import RubEquilibrium
-from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
+from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, to_scaled, wrap_angle
 from .state import CoreState
 from .wall import ContactWorkExceeded, WallForces, phase_integral
 
 __all__ = [
     "ETA_HEIGHT", "ETA_TIME", "LOCK_TOL", "MODE_FREE", "MODE_ROLLING", "MODE_SLIDING",
     "N_CASCADE", "RUB_RETRY", "STATUS_OK", "STATUS_WORK_CAP", "WORK_MAX", "Kinematics",
-    "StepReport", "TouchdownCore", "WorkCapExceeded", "work_cap",
+    "StateOutputs", "StepReport", "TouchdownCore", "WorkCapExceeded", "work_cap",
 ]
 
 
@@ -224,35 +226,38 @@ class TouchdownCore(FlightSteps, ContactSteps):
 
     def kinematics(self, Omega: float | None = None, amb_on: float | None = None) -> Kinematics:
         """Derived outputs at the current state, for the given (or last) inputs."""
-        return Kinematics._make(self.kinematics_values(Omega, amb_on))
+        return Kinematics._make(self.output_values(Omega, amb_on)[:N_KINEMATICS])
 
-    def kinematics_values(
+    def outputs(self, Omega: float | None = None, amb_on: float | None = None) -> StateOutputs:
+        """Everything an FMU publishes of the current state: the kinematics for the given
+        (or last) inputs, the spin speed and the counters (``StateOutputs``)."""
+        return StateOutputs._make(self.output_values(Omega, amb_on))
+
+    def output_values(
         self, Omega: float | None = None, amb_on: float | None = None
     ) -> tuple[float, ...]:
-        """The fields of ``kinematics`` as a plain tuple, in the same order (cheaper)."""
+        """The fields of ``outputs`` as a plain tuple, in the same order (cheaper): what
+        the state shows, as the step report shows what happened over the step."""
         W = self._inputs[0] if Omega is None else Omega
         a = self._inputs[2] if amb_on is None else amb_on
-        if self._mode:  # in contact the state is (theta, theta')
+        mode = self._mode
+        if mode:  # in contact the state is (theta, theta')
             z, v = self._wall_state()
         else:
             z, v = self._z, self._v
         p, psi = self._p, self._psi
         c_r = p.c_r
-        rot = cmath.exp(-1j * psi)
-        zr = z * rot
+        U, dU = to_scaled(z, v, W, c_r, psi)
         r = abs(z)
         rr = r * r
         whirl = (z.real * v.imag - z.imag * v.real) / rr if rr > 0.0 else (
             ((z.real * v.imag - z.imag * v.real) / r) / r if r > 0.0 else 0.0)
-        den = c_r * W
-        dU = (v - 1j * W * z) * rot / den if den != 0.0 else 0j
-        if not (math.isfinite(dU.real) and math.isfinite(dU.imag)):
-            dU = 0j  # |Omega| so small that dU/dt overflows: the Omega = 0 convention
         F_amb = a * (p.bias_force - p.c * v - p.k * z)
         return (
-            z.real, z.imag, v.real, v.imag, r / c_r, zr.real / c_r, zr.imag / c_r,
+            z.real, z.imag, v.real, v.imag, r / c_r, U.real, U.imag,
             dU.real, dU.imag, -psi if psi == -math.pi else psi, whirl,
             p.R * W + c_r * whirl, F_amb.real, F_amb.imag,
+            W, mode, self._n_impacts, self._t_last, self._v_last, self._E_diss,
         )
 
     # ------------------------------------------------------------------ stepping
@@ -276,7 +281,11 @@ class TouchdownCore(FlightSteps, ContactSteps):
         t0, s = self._t, h
         whole = self._whole_step(h, rep)  # choose: the whole step in one closed form?
         if whole is None:  # else segment by segment, each chosen where the last ended
-            s = self._segments(h, t0, rep, StepContext(cap, self._mode == MODE_SLIDING))
+            start = self._imb_start()
+            st = StepContext(cap, self._mode == MODE_SLIDING)
+            s = self._segments(h, t0, rep, st)
+            if not st.imb_whole:
+                self._imb_close(rep, start, s)
         self._finish(rep, t0, s, h, whole is not _PROVED_FREE)
         return rep
 
@@ -292,30 +301,26 @@ class TouchdownCore(FlightSteps, ContactSteps):
         return None
 
     def _segments(self, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
-        """The step loop: choose the next segment from the state, advance it, apply its
-        end (``_advance``), until the step is done or its work bound is reached. Returns
-        how far (s) into the step it got."""
+        """The step loop, one for every core: choose the next segment from the state,
+        advance it, apply its end (``_advance``), until the step is done or its work bound
+        is reached. Returns how far (s) into the step it got."""
         work, cap, s = st.work, st.cap, 0.0
-        start = self._imb_start()
         try:
             while s < h:
                 if work.total > cap:
                     raise WorkCapExceeded("before the next segment")
                 work.segs += SEGMENT_WORK
-                mode, s_before = self._mode, s
+                mode = self._mode
                 s = self._advance(s, h, t0, rep, st)
                 st.first = False
                 if self._mode != mode:
                     rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
-                    if s == s_before and MODE_FREE in (mode, self._mode):
-                        st.sticky_at = s  # N = 0 to rounding: contact holds past it
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
+            spin = " with the spin as a state" if self.SPIN_STATE else ""
             stop_at_work_bound(rep, st, exc, t0, s, h, (
-                f"{_SEGMENT_NAMES[self._mode]} (segment {work.segs // SEGMENT_WORK}, "
+                f"{_SEGMENT_NAMES[self._mode]}{spin} (segment {work.segs // SEGMENT_WORK}, "
                 f"{len(rep.impacts)} impacts in the step)"))
         rep.work = work.total
-        if not st.imb_whole:
-            self._imb_close(rep, start, s)
         return s
 
     def _finish(self, rep: StepReport, t0: float, s: float, h: float, tallied: bool) -> None:
@@ -356,7 +361,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         self._locked = False
 
     def _fill_report(self, rep: StepReport, h: float) -> None:
-        """Averages over h (s) of the impulses the step added to ``rep``; the mode."""
+        """Averages over h (s) of the impulses the step added to ``rep``."""
         inv = 1.0 / h if h > 0.0 else 0.0
         rep.F_contact = rep.P_contact * inv
         rep.F_n = rep.P_n * inv
@@ -364,7 +369,6 @@ class TouchdownCore(FlightSteps, ContactSteps):
             rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
         rep.T_f = -self._p.R * rep.P_t * inv
         rep.T_imb = rep.P_imb * inv
-        rep.mode = self._mode
         self._E_diss += rep.E_diss
 
     # ------------------------------------------------------------------ imbalance torque
@@ -420,10 +424,17 @@ class TouchdownCore(FlightSteps, ContactSteps):
         rep.P_imb += p.e_c * P
 
     def _advance(self, s: float, h: float, t0: float, rep: StepReport, st: StepContext) -> float:
-        """One segment from s seconds into the step: flight or contact, by the mode."""
-        if self._mode == MODE_FREE:
-            return self._advance_free(s, h, t0, rep, st)
-        return self._advance_contact(s, h, rep, st)
+        """One segment from s seconds into the step: flight or contact, by the mode. Where
+        flight and contact swap at N = 0 (a mode change in no time), contact holds past
+        that point (StepContext.sticky_at)."""
+        mode = self._mode
+        if mode == MODE_FREE:
+            s_end = self._advance_free(s, h, t0, rep, st)
+        else:
+            s_end = self._advance_contact(s, h, rep, st)
+        if s_end == s and self._mode != mode and MODE_FREE in (mode, self._mode):
+            st.sticky_at = s  # N = 0 to rounding: contact holds past it
+        return s_end
 
     # ------------------------------------------------------------------ state (de)serialisation
 

@@ -223,14 +223,14 @@ class Sliding:
             if gn <= 0.0 or sv <= 0.0:
                 x, y_ev, kind = self._locate(u, y, f0, step, k, tally)
                 self._store_integrals(tally, y_ev, u + x)
-                return SegmentEnd(u + x, y_ev[0], y_ev[1], kind, tally, H)
+                return SegmentEnd(u + x, y_ev[0], y_ev[1], kind, tally, H, work=tally.work)
             tally.peak = max(tally.peak, gn)
             u_next = u + step if step < rem - u else rem
             u, y = u_next, y_new
             if not cut:  # a cut step says nothing about the step the motion allows
                 H = min(gbs.next_step_size(step, err, k), self.h_max)
         self._store_integrals(tally, y, rem)
-        return SegmentEnd(rem, y[0], y[1], None, tally, H)
+        return SegmentEnd(rem, y[0], y[1], None, tally, H, work=tally.work)
 
     def _step_scale(self, rates: tuple[float, ...], step: float, y: list[float]) -> list[float]:
         """Error scales of one step: theta and theta' as in __init__; each quadrature

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 from . import gbs
 from .params import RotorParams
-from .wall import ContactWorkExceeded
+from .wall import ContactTally, ContactWorkExceeded, SegmentEnd
 
 RTOL = 1e-13
 """Relative tolerance per extrapolated step, every component."""
@@ -78,26 +78,6 @@ class ContactForces:
     F_t: float
     ddtheta: float
     dOmega: float
-
-
-@dataclass(frozen=True, slots=True)
-class SpinSegmentEnd:
-    """Where a contact segment stopped (SI): after ``duration`` s, the state, the event
-    (None at the end of ``rem``), and its impulses: P_n = int N, P_t = int F_t (N s),
-    P_c = int F_c (complex N s), E_diss (J), N_peak (N), work (units)."""
-
-    duration: float
-    theta: float
-    dtheta: float
-    psi: float
-    Omega: float
-    event: str | None
-    P_n: float
-    P_t: float
-    P_c: complex
-    E_diss: float
-    N_peak: float
-    work: int
 
 
 _NAN6 = (math.nan,) * 6
@@ -247,7 +227,7 @@ class SpinContact:
         rhs = self.rhs
         return lambda u0, y0, f0, H, n: gbs.midpoint(rhs, u0, y0, f0, H, n)
 
-    def run(self, rem: float, limit: int) -> SpinSegmentEnd:
+    def run(self, rem: float, limit: int) -> SegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
         y = self.y0 + [0.0] * 5
         nq = self.nq
@@ -283,8 +263,7 @@ class SpinContact:
             y, f0 = y1, f1
             N_peak = max(N_peak, abs(f1[nq]))
             H = gbs.next_step_size(Hs, err, k)
-        self.next_step = H
-        return self._end(u, y, event, N_peak, work)
+        return self._end(u, y, event, N_peak, work, H)
 
     def _event_in_step(self, sweep: Callable[..., Vector], u: float, y: Vector, f0: Vector,
                        y1: Vector, f1: Vector, Hs: float, k: int, scale: Vector
@@ -338,8 +317,8 @@ class SpinContact:
                 side = -1
         return b, yb, work
 
-    def _end(self, u: float, y: Vector, event: str | None, N_peak: float,
-             work: int) -> SpinSegmentEnd:
+    def _end(self, u: float, y: Vector, event: str | None, N_peak: float, work: int,
+             next_step: float) -> SegmentEnd:
         p = self.h.p
         if self.rolling:
             theta, psi, Omega = y[0], y[1], y[2]
@@ -347,5 +326,8 @@ class SpinContact:
         else:
             theta, dtheta, psi, Omega = y[0], y[1], y[2], y[3]
         q = y[self.nq:]
-        return SpinSegmentEnd(u, theta, dtheta, psi, Omega, event, q[0], q[1],
-                              complex(q[2], q[3]), q[4], N_peak, work)
+        mc = p.m * p.c_r  # the tally is per unit m c_r (wall.ContactTally)
+        tally = ContactTally(I_n=q[0] / mc, I_c=complex(q[2], q[3]) / mc, I_t=q[1] / mc,
+                             I_e=q[4] / (mc * p.c_r), peak=N_peak / mc, work=work)
+        return SegmentEnd(u, theta, dtheta, event, tally, next_step, psi=psi,
+                          Omega=Omega, work=work)

@@ -24,20 +24,16 @@ import cmath
 import math
 from dataclasses import replace
 
-from .events import SEGMENT_WORK, WORK_MAX
+from .events import WORK_MAX
 from .flight_step import starts_contact
 from .impact import Impact
 from .params import InputError, RotorParams, check_finite, check_range
 from .report import (
-    _MODE_NAMES,
-    _SEGMENT_NAMES,
     MODE_FREE,
     MODE_ROLLING,
     MODE_SLIDING,
     StepContext,
     StepReport,
-    WorkCapExceeded,
-    stop_at_work_bound,
 )
 from .rigid import Delassus, check_well_posed, spin_impact
 from .simulator import TouchdownCore
@@ -49,9 +45,9 @@ from .spin_contact import (
     rolling_forces,
     sliding_forces,
 )
-from .spin_flight import SpinFlight
+from .spin_flight import SpinFlight, free_acceleration
 from .state import CoreState
-from .wall import ContactWorkExceeded
+from .wall import SegmentEnd
 
 
 class SpinCore(TouchdownCore):
@@ -126,7 +122,9 @@ class SpinCore(TouchdownCore):
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
         rep = StepReport(work_cap=cap)
         t0, W0 = self._t, self._inputs[0]
-        s = self._spin_segments(h, t0, held, rep, StepContext(cap))
+        st = StepContext(cap)
+        st.held = held
+        s = self._segments(h, t0, rep, st)
         self._finish(rep, t0, s, h, True)
         self._imbalance_torque(rep, W0, held.T_drive, h if s >= h else self._t - t0)
         return rep
@@ -141,53 +139,35 @@ class SpinCore(TouchdownCore):
             rep.P_imb = self._J * (self._inputs[0] - W0) - T_drive * span + self._p.R * rep.P_t
             rep.T_imb = rep.P_imb / span
 
-    def _spin_segments(self, h: float, t0: float, held: HeldInputs, rep: StepReport,
-                       st: StepContext) -> float:
-        """The step loop: flight or contact segments until h (s) or the work bound."""
-        work, cap, s = st.work, st.cap, 0.0
-        try:
-            while s < h:
-                if work.total > cap:
-                    raise WorkCapExceeded("before the next segment")
-                work.segs += SEGMENT_WORK
-                mode = self._mode
-                if mode == MODE_FREE:
-                    s = self._spin_flight(s, h, t0, held, rep, st)
-                else:
-                    s = self._spin_contact(s, h, t0, held, rep, st)
-                if self._mode != mode:
-                    rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
-        except (WorkCapExceeded, ContactWorkExceeded) as exc:
-            stop_at_work_bound(rep, st, exc, t0, s, h, (
-                f"{_SEGMENT_NAMES[self._mode]} with the spin as a state "
-                f"({len(rep.impacts)} impacts in the step)"))
-        rep.work = work.total
-        return s
-
     def _set_psi(self, psi: float) -> None:
         """Set the spin angle from an unwrapped value psi = _psi + increment (rad)."""
         self._add_psi(psi - self._psi)
 
     # ------------------------------------------------------------------ flight and impacts
 
-    def _spin_flight(self, s: float, h: float, t0: float, held: HeldInputs,
-                     rep: StepReport, st: StepContext) -> float:
-        """A free-flight segment from s (s) into the step; an impact or contact at its end."""
+    def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
+                      st: StepContext) -> float:
+        """A free-flight segment from s (s) into the step (``SpinFlight``); an impact or
+        contact at its end."""
         rem = (h - s) - st.s_lo
-        W = self._inputs[0]
-        fl = SpinFlight(self._p, self._J, held.a, held.F_ext, held.T_drive, self._z, self._v,
-                        self._psi, W).run(rem, st.cap - st.work.total)
-        st.work.iters += fl.work
-        self._z, self._v = fl.z, fl.v
-        self._set_psi(fl.psi)
-        self._set_spin(fl.Omega)
-        if fl.event is None:
+        held = st.held
+        end = SpinFlight(self._p, self._J, held.a, held.F_ext, held.T_drive, self._z,
+                         self._v, self._psi, self._inputs[0]).run(rem, st.cap - st.work.total)
+        st.work.iters += end.work
+        self._z, self._v = end.z, end.v
+        self._advance_spin(end)
+        if end.event is None:
             return h
-        s_wall = st.later(s, min(fl.duration, rem))
+        s_wall = st.later(s, min(end.duration, rem))
         sticky = s_wall == s == st.sticky_at  # a second zero-length flight here
         if not self._at_wall(t0 + s_wall + st.s_lo, held, rep, st, sticky):
             st.sticky_at = s_wall  # touched, but no contact force: flight again
         return s_wall
+
+    def _advance_spin(self, end: SegmentEnd) -> None:
+        """The spin at a segment's end: its angle and speed, states of the segment."""
+        self._set_psi(end.psi)
+        self._set_spin(end.Omega)
 
     def _set_spin(self, W: float) -> None:
         self._inputs = (W, *self._inputs[1:])
@@ -250,8 +230,7 @@ class SpinCore(TouchdownCore):
         p = self._p
         E = cmath.exp(1j * (self._psi + p.phi))
         F = held.a * (p.bias_force - p.c * v - p.k * z) + held.F_ext
-        dW = (held.T_drive + p.e_c * (F.real * E.imag - F.imag * E.real)) / self._J
-        zdd = (F - 1j * p.m * p.g) / p.m + p.e_c * (W * W - 1j * dW) * E
+        zdd, _ = free_acceleration(F, p.m, p.g, p.e_c, self._J, held.T_drive, W, E)
         n = z / abs(z)
         w = n.conjugate() * v
         return (n.conjugate() * zdd).real + w.imag * w.imag / abs(z)
@@ -302,33 +281,27 @@ class SpinCore(TouchdownCore):
         f = self._contact_forces(held, s)
         return (MODE_SLIDING, s) if n_min < f.N else (MODE_FREE, 0.0)
 
-    def _spin_contact(self, s: float, h: float, t0: float, held: HeldInputs,
-                      rep: StepReport, st: StepContext) -> float:
-        """A contact segment from s (s) into the step; the transition at its end."""
+    def _advance_contact(self, s: float, h: float, rep: StepReport, st: StepContext
+                         ) -> float:
+        """A contact segment from s (s) into the step (``SpinContact``); the transition at
+        its end."""
         rem = (h - s) - st.s_lo
         slip = 0.0 if self._mode == MODE_ROLLING else self._slip
-        seg = SpinContact(held, slip, self._theta, self._dtheta, self._psi, self._inputs[0],
-                          self._slide_step, st.n_slack if s == st.sticky_at else 0.0)
+        seg = SpinContact(st.held, slip, self._theta, self._dtheta, self._psi,
+                          self._inputs[0], self._slide_step,
+                          st.n_slack if s == st.sticky_at else 0.0)
         end = seg.run(rem, st.cap - st.work.total)
         st.work.iters += end.work
-        self._slide_step = seg.next_step
-        self._theta, self._dtheta = end.theta, end.dtheta
-        self._set_psi(end.psi)
-        self._set_spin(end.Omega)
-        rep.P_n += end.P_n
-        rep.P_t += end.P_t
-        rep.P_contact += end.P_c
-        rep.E_diss += end.E_diss
-        rep.F_n_peak = max(rep.F_n_peak, end.N_peak)
-        if end.event is None:
-            return h
-        s = st.later(s, min(end.duration, rem))
-        self._transition(end.event, held)
-        return s
+        self._slide_step = end.next_step
+        self._end_segment(end, rep, st, 1.0 + 0j)  # (I_z = 0: T_imb from the spin balance)
+        return st.later(s, end.duration) if end.duration < rem else h
 
-    def _transition(self, event: str, held: HeldInputs) -> None:
+    def _transition(self, event: str | None, st: StepContext | None) -> None:
         """Apply a contact segment's event: lift-off to flight, or a new contact mode."""
-        p = self._p
+        if event is None:
+            return
+        assert st is not None
+        held, p = st.held, self._p
         if event == "lift_off":
             self._leave_wall()
             return

@@ -91,12 +91,11 @@ from __future__ import annotations
 import bisect
 import cmath
 import math
-from dataclasses import dataclass
 from operator import mul
 
 from .events import Work, safe_step
 from .params import RotorParams
-from .wall import ContactWorkExceeded
+from .wall import ContactWorkExceeded, SegmentEnd
 
 EPS = 2.220446049250313e-16
 TINY = 5e-324
@@ -134,24 +133,15 @@ dense output stays below 6 eps (1.2e-15 c_r) over 14 steps (0.1 s) in tests/test
 scenes, against the 36 eps assumed there."""
 
 
-@dataclass(frozen=True)
-class FlightEnd:
-    """Where a free flight stopped (inertial frame, SI)."""
-
-    duration: float
-    """s, from the segment start to its end or to the contact."""
-    z: complex
-    """m, geometric centre at the end (on |z| = c_r, projected onto it, for a contact)."""
-    v: complex
-    """m/s, z' at the end."""
-    psi: float
-    """rad, spin angle at the end (unwrapped: psi0 + increment)."""
-    Omega: float
-    """rad/s, spin speed at the end."""
-    event: str | None
-    """"contact" (|z| reaches c_r from inside, or a touch) or None (rem reached)."""
-    work: int
-    """Deterministic work units used (module docstring)."""
+def free_acceleration(F: complex, m: float, g: float, e_c: float, J: float, T: float,
+                      Omega: float, E: complex) -> tuple[complex, float]:
+    """(z'' (m/s^2), Omega' (rad/s^2)) of the rotor in free flight, its spin a state, SI,
+    inertial: F (N) the bearing and external force at the geometric centre, m (kg), g
+    (m/s^2), e_c (m), J (kg m^2), T the drive torque (N m), Omega (rad/s) and E =
+    e^{i(psi + phi)}. From m z_G'' = F - i m g, z_G = z + e_c E, and J Omega' = T +
+    e_c Im(conj(F) E)."""
+    dOmega = (T + e_c * (F.conjugate() * E).imag) / J
+    return F / m - 1j * g + e_c * complex(Omega * Omega, -dOmega) * E, dOmega
 
 
 class SpinFlight:
@@ -250,8 +240,7 @@ class SpinFlight:
         """(z'', z''') in m/s^2, m/s^3 from the ODE at the state (z, v, Omega, E)."""
         ec, J = self.ec, self.J
         F = self.F0 - self.cA * v - self.kA * z
-        Omd = (self.T + ec * (F.conjugate() * E).imag) / J
-        acc = F / self.m - 1j * self.g + ec * complex(Om * Om, -Omd) * E
+        acc, Omd = free_acceleration(F, self.m, self.g, ec, J, self.T, Om, E)
         F1 = -self.cA * acc - self.kA * v
         Omdd = ec * (F1.conjugate() * E + F.conjugate() * (1j * Om) * E).imag / J
         jerk = F1 / self.m + ec * complex(3.0 * Om * Omd, Om * Om * Om - Omdd) * E
@@ -389,7 +378,7 @@ class SpinFlight:
         return tau, G3, G4
 
     # ---------------------------------------------------------------- search
-    def run(self, rem: float, limit: int) -> FlightEnd:
+    def run(self, rem: float, limit: int) -> SegmentEnd:
         """Advance at most ``rem`` s; stop at the first contact; raise ContactWorkExceeded
         (with ``work``) if more than ``limit`` work units would be needed."""
         if not rem >= 0.0:
@@ -454,7 +443,7 @@ class SpinFlight:
             s = s + u if u < remaining else rem
             z, v, dpsi, Om, E = self.state(s, work)
 
-    def _run_closed(self, rem: float, limit: int, work: Work) -> FlightEnd:
+    def _run_closed(self, rem: float, limit: int, work: Work) -> SegmentEnd:
         """``run`` for the closed form: the same steps as the general loop, with the point
         (``state``, ``derivs``) and the bound (``bounds``) evaluated inline (the drop scene
         runs this every flight; tests compare it with the forced Taylor path)."""
@@ -570,7 +559,7 @@ class SpinFlight:
         return min(max(t_bound, t_cubic), tau)
 
     def _polish(self, s: float, z: complex, v: complex, dpsi: float, Om: float, rem: float,
-                work: Work) -> FlightEnd:
+                work: Work) -> SegmentEnd:
         """Newton on G from a point within TOL_G of the wall moving outward; best point."""
         ic2 = 1.0 / (self.cr * self.cr)
         zc = z.conjugate()
@@ -597,13 +586,14 @@ class SpinFlight:
         return self._end(s, z, v, dpsi, Om, "contact", work)
 
     def _end(self, s: float, z: complex, v: complex, dpsi: float, Om: float,
-             event: str | None, work: Work) -> FlightEnd:
-        """The FlightEnd at s; a contact's z is projected onto the circle."""
+             event: str | None, work: Work) -> SegmentEnd:
+        """The segment's end at s; a contact's z is projected onto the circle."""
         if event == "contact":
             r = abs(z)
             if r > 0.0:
                 z = z * (self.cr / r)
-        return FlightEnd(s, z, v, self.psi0 + dpsi, Om, event, work.total)
+        return SegmentEnd(s, event=event, z=z, v=v, psi=self.psi0 + dpsi, Omega=Om,
+                          work=work.total)
 
 
 def _tail_step(a: float, b: float, tol: float, N: int) -> float:

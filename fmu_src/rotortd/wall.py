@@ -2,15 +2,15 @@
 
 Frame and units: inertial, SI; forces per unit m c_r (1/s^2), as in ``rotortd.contact``'s
 docstring. WallForces: the contact-free forces at the wall under held inputs.
-ContactTally: a segment's contact integrals. SegmentEnd: what every contact segment's
-``run(rem, limit)`` returns.
+ContactTally: a segment's contact integrals. SegmentEnd: what every segment's
+``run(rem, limit)`` returns, flight or contact, the spin held or a state.
 """
 
 from __future__ import annotations
 
 import cmath
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from .divdiff import dd2
 from .events import G2_FLOOR
@@ -119,22 +119,46 @@ class ContactTally:
     I_e: float = 0.0
     peak: float = 0.0
     work: int = 0
+    """Work units (events.Work) counted while the segment runs; its SegmentEnd.work."""
     I_z: complex = 0j
 
 
-@dataclass
+@dataclass(slots=True)
 class SegmentEnd:
-    """Where a contact segment stopped: after ``duration`` seconds, state, and the event.
+    """Where a segment stopped: after ``duration`` seconds, its state, and its event.
 
-    Every contact segment (Sliding, Rolling, LinearRub, QuadraticRub, LockedRub) returns
-    one from ``run(rem, limit)``: advance at most ``rem`` seconds, at most ``limit`` work
-    units, and stop at the first event."""
+    Every segment returns one from ``run(rem, limit)``: advance at most ``rem`` seconds, at
+    most ``limit`` work units, and stop at the first event. The segments: free flight
+    (``flight_step.Flight``; with the spin a state ``spin_flight.SpinFlight``), sliding,
+    rolling, the linear and quadratic rub and the locked rotation (``Sliding``,
+    ``Rolling``, ``LinearRub``, ``QuadraticRub``, ``LockedRub``; with the spin a state
+    ``spin_contact.SpinContact``). A flight ends in (z, v), a contact segment in (theta,
+    theta') with its contact integrals ``tally``; a segment whose spin is a state also ends
+    in (psi, Omega), which are NaN where the spin is held (the core advances psi by
+    Omega duration)."""
 
     duration: float
     """Length of the segment (s), from its start to its end or event."""
-    theta: float
-    dtheta: float
-    event: str | None  # None (end), "lift_off", "slip_zero", "slip_stuck", "cone"
-    tally: ContactTally = field(default_factory=ContactTally)
+    theta: float = math.nan
+    """Contact: polar angle of the contact point at the end (rad, inertial)."""
+    dtheta: float = math.nan
+    """Contact: whirl rate theta' at the end (rad/s)."""
+    event: str | None = None
+    """None (rem reached); flight: "impact", "touch" (held spin; "clear": the search
+    stopped at its advance limit, resume from the end), "contact" (spin a state); contact:
+    "lift_off", "slip_zero", "slip_stuck", "cone" (held spin), "slip_start" (spin a
+    state)."""
+    tally: ContactTally | None = None
+    """Contact: the segment's contact integrals (per unit m c_r); None for a flight."""
     next_step: float = math.inf
-    """Sliding only: the integrator's step size (s) for the next sliding segment."""
+    """Integrated contact: the integrator's step size (s) for the next such segment."""
+    z: complex = 0j
+    """Flight: position of the rotor centre at the end (m, inertial)."""
+    v: complex = 0j
+    """Flight: its velocity (m/s, inertial)."""
+    psi: float = math.nan
+    """Spin a state: spin angle at the end (rad, unwrapped: the start's + increment)."""
+    Omega: float = math.nan
+    """Spin a state: spin speed at the end (rad/s)."""
+    work: int = 0
+    """Deterministic work units the segment used (events.Work)."""

@@ -4,7 +4,8 @@ The FMU's script ``fmu_src/RotorTouchdown.py`` only subclasses ``RotorTouchdownA
 
 A thin layer over the physics core ``rotortd`` (see docs/core-api.md). It declares the FMI
 variables, validates parameters and inputs, hands each communication step to
-``TouchdownCore.step`` and publishes the step report and the kinematics.
+``TouchdownCore.step`` and publishes the step report (what happened over the step) and
+``TouchdownCore.output_values`` (what the state shows at its end).
 
 Rules this file follows (see the project's FMI notes):
 - ``__init__`` is cheap and free of side effects (the builder instantiates the class).
@@ -96,7 +97,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._seen_tunables: tuple | None = None
         self._seen_inputs: tuple | None = None
         self._h_spin_warned = False  # h_spin is deprecated: warned once if set
-        self._kinematics: tuple[float, ...] = ()  # the last published kinematics
+        self._state_outputs: tuple[float, ...] = ()  # the last published state outputs
 
     def _watched_setter(self, name: str) -> Any:
         """FMI setter of a parameter or input: stores the value and marks the values as
@@ -128,11 +129,8 @@ class RotorTouchdownAdapter(GuardedSlave):
             self._core = self._make_core(rotortd)
         except rotortd.CrossParameterError as exc:
             raise ModelError(f"cross-parameter constraint: {exc}") from exc
-        omega = self._input_values()[0]
-        self.Omega_out = omega
         self._fixed_snapshot = self._fixed_values()
-        self._publish_kinematics(omega, float(self.amb_on))
-        self._publish_counters()
+        self._publish_state(self._input_values()[0], float(self.amb_on))
         self._publish_step_outputs(None, 0)
 
     def _make_core(self, rotortd: Any) -> Any:
@@ -255,18 +253,14 @@ class RotorTouchdownAdapter(GuardedSlave):
         t_target = core.t + step_size
         if core.SPIN_STATE:
             rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
-            omega = core.Omega
         else:
             rep = core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
-        self.Omega_out = omega
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
-        self._publish_kinematics(omega, amb)
-        if rep.impacts or rep.transitions or rep.E_diss:  # else the counters stand
-            self._publish_counters()
+        self._publish_state(None, amb)  # (the spin: the held input or the core's state)
         self._publish_step_outputs(rep, len(rep.impacts))
-        total = (sum(self._kinematics) + rep.F_contact.real + rep.F_contact.imag + rep.F_n
-                 + rep.F_n_peak + rep.P_n + rep.T_f + rep.T_imb + omega + self.E_diss)
+        total = (sum(self._state_outputs) + rep.F_contact.real + rep.F_contact.imag
+                 + rep.F_n + rep.F_n_peak + rep.P_n + rep.T_f + rep.T_imb)
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
         if rep.status == 0 and abs(core.t - t_target) <= tol:
@@ -298,20 +292,15 @@ class RotorTouchdownAdapter(GuardedSlave):
         return True
 
     # ------------------------------------------------------------------ publishing
-    def _publish_kinematics(self, omega: float, amb: float) -> None:
-        self._kinematics = kin = self._core.kinematics_values(omega, amb)
+    def _publish_state(self, omega: float | None, amb: float) -> None:
+        """Publish what the state shows (``TouchdownCore.output_values``: kinematics, spin
+        speed, mode, counters) for the spin speed omega (None: the core's own) and amb."""
+        self._state_outputs = out = self._core.output_values(omega, amb)
         (self.x, self.y, self.vx, self.vy, self.r_rel, self.u_re, self.u_im, self.du_re,
-         self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x,
-         self.F_amb_y) = kin
-
-    def _publish_counters(self) -> None:
-        core = self._core
-        self.mode = core.mode
-        self.in_contact = core.mode != 0
-        self.n_impacts = core.n_impacts
-        self.t_last_impact = core.t_last_impact
-        self.v_last_impact = core.v_last_impact
-        self.E_diss = core.E_diss
+         self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x, self.F_amb_y,
+         self.Omega_out, self.mode, self.n_impacts, self.t_last_impact, self.v_last_impact,
+         self.E_diss) = out
+        self.in_contact = self.mode != 0
 
     def _publish_step_outputs(self, rep: Any, n_step: int) -> None:
         if rep is None:

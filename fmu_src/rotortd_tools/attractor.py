@@ -71,11 +71,8 @@ class Recorder:
             self.angles.append(wrap_angle(ang))
             self.speeds.append(imp.rdot / (self.c_r * Omega))
             self.r_max = max(self.r_max, 1.0)
-        t_prev = t0
-        for t_tr, kind in rep.transitions:
-            self._dwell(mode, t_tr - t_prev)
-            mode, t_prev = _MODE_OF[kind], t_tr
-        self._dwell(mode, core.t - t_prev)
+        for seg_mode, dt in dwell_times(mode, t0, rep.transitions, core.t):
+            self._dwell(seg_mode, dt)
         r = abs(core.z) / self.c_r
         self.r_max, self.r_min = max(self.r_max, r), min(self.r_min, r)
         return rep.status
@@ -88,6 +85,18 @@ class Recorder:
 
 
 _MODE_OF = {"sliding": MODE_SLIDING, "rolling": MODE_ROLLING, "lift_off": MODE_FREE}
+
+
+def dwell_times(mode: int, t0: float, transitions: list[tuple[float, str]], t1: float
+                ) -> list[tuple[int, float]]:
+    """(mode, time in it (s)) for each stretch of a step from t0 to t1 (s) that began in
+    ``mode``, split at the step report's ``transitions``."""
+    out, t_prev = [], t0
+    for t_tr, kind in transitions:
+        out.append((mode, t_tr - t_prev))
+        mode, t_prev = _MODE_OF[kind], t_tr
+    out.append((mode, t1 - t_prev))
+    return out
 
 
 def run_to_attractor(core: TouchdownCore, Omega: float, h: float, n_transient: int,
@@ -195,11 +204,8 @@ class DropRecorder:
         self.n_impacts += len(rep.impacts)
         if rep.impacts:
             self.r_max = max(self.r_max, 1.0)
-        t_prev = t0
-        for t_tr, kind in rep.transitions:
-            self._dwell(mode, t_tr - t_prev)
-            mode, t_prev = _MODE_OF[kind], t_tr
-        self._dwell(mode, core.t - t_prev)
+        for seg_mode, dt in dwell_times(mode, t0, rep.transitions, core.t):
+            self._dwell(seg_mode, dt)
         k = core.kinematics(Omega if T_drive is None else None, 0.0)
         W = Omega if T_drive is None else core.Omega  # type: ignore[attr-defined]
         self.n += 1
