@@ -333,3 +333,24 @@ def test_state_round_trip_keeps_the_torque_bit_for_bit() -> None:
         saved = json.loads(json.dumps(core.get_state()))
         a, b = core.step(1e-3, W0), restore_core(saved).step(1e-3, W0)
         assert (a.T_imb, a.P_imb) == (b.T_imb, b.P_imb)
+
+
+@pytest.mark.parametrize("gamma", [0.3, 0.065])
+def test_switched_off_the_motion_is_the_same_to_the_bit(gamma: float) -> None:
+    """``imbalance_torque = False`` skips the torque's work (T_imb and P_imb are NaN) and
+    moves the rotor exactly as with it on: impacts, chattering, sliding (its auxiliary
+    quadrature no longer refined) and rolling, over 1 s at 1e-3 s steps."""
+    W0 = 184.2
+    p = RotorParams().replace(c=gamma * 50 * W0)
+    on = TouchdownCore(p, 0.2 * p.c_r, 0.5j * p.c_r * W0)
+    off = TouchdownCore(p, 0.2 * p.c_r, 0.5j * p.c_r * W0)
+    off.imbalance_torque = False
+    modes = set()
+    for _ in range(1000):
+        a, b = on.step(1e-3, W0), off.step(1e-3, W0)
+        assert (a.F_contact, a.F_n, a.T_f, a.impacts) == (b.F_contact, b.F_n, b.T_f, b.impacts)
+        assert math.isfinite(a.T_imb) and math.isnan(b.T_imb) and math.isnan(b.P_imb)
+        modes.add(on.mode)
+    assert on.n_impacts > 100 and modes >= {0, 1}
+    s_on, s_off = on.get_state(), off.get_state()
+    assert s_on.pop("imb_h") != s_off.pop("imb_h") and s_on == s_off

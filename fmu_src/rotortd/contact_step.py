@@ -98,7 +98,8 @@ class ContactSteps:
             end = rub.run(rem)
         else:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
-            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step)
+            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step,
+                          self.imbalance_torque)
             end = seg.run(self._slide_span(rem), st.cap - st.work.total)
             self._slide_step = end.next_step
         st.work.iters += end.work
@@ -112,7 +113,8 @@ class ContactSteps:
         end without event)."""
         p = self._p
         rep.add_contact(end.tally, p.m * p.c_r, p.c_r)
-        self._imb_add(rep, E, p.c_r * end.tally.I_z)
+        if self.imbalance_torque:
+            self._imb_add(rep, E, p.c_r * end.tally.I_z)
         self._theta, self._dtheta = wrap_angle(end.theta), end.dtheta
         self._advance_spin(end)
         self._transition(end.event, st)
@@ -138,7 +140,8 @@ class ContactSteps:
         end = rub.run(h)
         rep.work = end.work
         self._end_segment(end, rep, None, E)
-        self._imb_close(rep, start, h)
+        if self.imbalance_torque:
+            self._imb_close(rep, start, h)
         return True
 
     def _leaves_wall(self, E: complex) -> bool:

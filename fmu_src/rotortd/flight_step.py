@@ -69,12 +69,15 @@ class FlightSteps:
                     return False
         z0, v0 = self._z, self._v
         self._z, self._v = fm.propagate(z0, v0, E, h, cache=True)
-        if self._imb_free_h == h:  # the imbalance reaction's impulse, closed form (cached)
+        if not self.imbalance_torque:
+            rep.P_imb = rep.T_imb = math.nan
+        elif self._imb_free_h == h:  # the imbalance reaction's impulse, closed form (cached)
             bz, bv, b0, bE = self._imb_free
             rep.P_imb = P = (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
+            rep.T_imb = P / h
         else:
             rep.P_imb = P = self._imb_flight(z0, v0, E, h)
-        rep.T_imb = P / h
+            rep.T_imb = P / h
         self._advance_psi(h)
         self._on_wall = False
         rep.work = work
@@ -132,20 +135,21 @@ class FlightSteps:
         seconds left): its state, its term of P_imb, and an impact or the entry into
         contact at its event. Returns how far into the step it got (s)."""
         fm, E, z0, v0 = self._fm, seg.E, seg.z0, seg.v0
+        imb = self.imbalance_torque
         if end.event is None:  # the rest of the step is free
             self._z, self._v = end.z, end.v
-            if st.first:  # the whole step in one flight: as a proved-free one (closed form)
-                rep.P_imb = self._imb_flight(z0, v0, E, rem)
+            if imb and st.first:  # the whole step in one flight: as a proved-free one
+                rep.P_imb = self._imb_flight(z0, v0, E, rem)  # (closed form)
                 st.imb_whole = True
-            else:
+            elif imb:
                 self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, self._z, self._v, rem))
             self._advance_psi(rem)
             self._on_wall = False
             return h
         ds = min(end.duration, rem)
-        if ds == end.duration:  # the flight's end is the hit's state
+        if imb and ds == end.duration:  # the flight's end is the hit's state
             self._imb_add(rep, E, fm.imb_integral_ends(z0, v0, E, end.z, end.v, ds))
-        else:
+        elif imb:
             self._imb_add(rep, E, fm.imb_integral(z0, v0, E, ds))
         self._advance_psi(ds)
         if end.event == "clear":

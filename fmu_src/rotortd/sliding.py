@@ -50,8 +50,10 @@ class Sliding:
         s: float,
         gn_slack: float = 0.0,
         step0: float = math.inf,
+        aux: bool = True,
     ) -> None:
         self.wf = wf
+        self.aux = aux  # refine the auxiliary quadrature Z (False: Z is not needed)
         self.step0 = step0  # first integrator step (s); inf: 0.05/w
         self.gn_slack = gn_slack  # lift-off only once Gn < -gn_slack (1/s^2)
         self.s = s
@@ -246,10 +248,12 @@ class Sliding:
             rates[3] * step + RTOL * abs(y[5]) + SCALE_FLOOR,
         ]
 
-    def _aux_scale(self, step: float, y: list[float]) -> tuple[float, float]:
+    def _aux_scale(self, step: float, y: list[float]) -> tuple[float, ...]:
         """Error scales (s) of the auxiliary quadrature Z = int e^{i(theta - Omega u)} du of
         one step: aux_rate times the step plus RTOL of its accumulated value, at least
-        SCALE_FLOOR."""
+        SCALE_FLOOR; none (Z is neither controlled nor refined) when ``aux`` is False."""
+        if not self.aux:
+            return ()
         z = self.aux_rate * step + RTOL * abs(complex(y[6], y[7])) + SCALE_FLOOR
         return z, z
 

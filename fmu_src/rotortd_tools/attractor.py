@@ -105,7 +105,9 @@ def run_to_attractor(core: TouchdownCore, Omega: float, h: float, n_transient: i
     """Step ``core`` n_transient times by h (s) at Omega (rad/s), then n_record times with a
     Recorder; return (recorder, "") or, when a step stops at the work cap, (None, message).
     The record window starts at the core's time after the transient. With ``T_drive``
-    (N m) the core is a SpinCore driven by it (Omega then only scales the record)."""
+    (N m) the core is a SpinCore driven by it (Omega then only scales the record). The
+    imbalance torque is not computed (``TouchdownCore.imbalance_torque``): nothing reads it."""
+    core.imbalance_torque = False
     for _ in range(n_transient):
         rep = (core.step(h, Omega) if T_drive is None
                else core.step(h, T_drive=T_drive))  # type: ignore[call-arg]
@@ -242,7 +244,9 @@ def run_drop(core: TouchdownCore, Omega: float, h: float, n_steps: int, n_window
     """Drop: step ``core`` n_steps times by h (s) with the bearing off (amb_on = 0) and
     gravity as the core's parameters have it, recording the last n_window steps; Omega
     (rad/s) is the held spin, or ignored with ``T_drive`` (N m, a SpinCore). Return
-    (recorder, "") or (None, message) when a step stops at the work cap."""
+    (recorder, "") or (None, message) when a step stops at the work cap. The imbalance
+    torque is not computed, as in run_to_attractor."""
+    core.imbalance_torque = False
     n_window = min(n_window, n_steps)
     for i in range(n_steps - n_window):
         rep = (core.step(h, Omega, amb_on=0.0) if T_drive is None
