@@ -92,6 +92,9 @@ def test_state_conversions_are_the_cores_bit_for_bit() -> None:
         assert (U2.real, U2.imag, dU2.real, dU2.imag) == (k.u_re, k.u_im, k.du_re, k.du_im)
         assert abs(U2 - U) < 1e-14 and abs(dU2 - dU) < 1e-12
     assert S.to_scaled(1e-4 + 0j, 1j, 0.0, p.c_r, 0.0)[1] == 0j
+    slow = TouchdownCore(p, 1e-4 + 0j, 1j)  # c_r Omega underflows: the Omega = 0 convention
+    k = slow.kinematics(1e-320)
+    assert S.to_scaled(slow.z, slow.v, 1e-320, p.c_r, 0.0)[1] == complex(k.du_re, k.du_im) == 0
 
 
 def test_regular_equilibrium_is_the_cores_steady_whirl_and_gamma_beb_its_wall() -> None:

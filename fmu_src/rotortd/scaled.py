@@ -127,7 +127,8 @@ def to_scaled(
 
     U = z e^{-i psi}/c_r, U' = (z' - i Omega z) e^{-i psi}/(c_r Omega); U' = 0 where it is
     undefined (Omega = 0) or overflows (|Omega| so small that c_r Omega underflows or the
-    quotient is not finite). ``TouchdownCore.outputs`` publishes these.
+    quotient is not finite). ``TouchdownCore.output_values`` has the same expressions inline
+    (every FMU step; bit for bit, tests/test_scaled.py).
     """
     rot = cmath.exp(-1j * psi)
     zr = z * rot

@@ -44,7 +44,7 @@ from .report import (
     work_cap,
 )
 from .rub import RubEquilibrium
-from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, to_scaled, wrap_angle
+from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 from .state import CoreState
 from .wall import ContactWorkExceeded, WallForces, phase_integral
 
@@ -252,14 +252,19 @@ class TouchdownCore(FlightSteps, ContactSteps):
             z, v = self._z, self._v
         p, psi = self._p, self._psi
         c_r = p.c_r
-        U, dU = to_scaled(z, v, W, c_r, psi)
+        rot = cmath.exp(-1j * psi)  # scaled.to_scaled inline, bit for bit (test_scaled.py)
+        U = z * rot
+        den = c_r * W
+        dU = (v - 1j * W * z) * rot / den if den != 0.0 else 0j
+        if not (math.isfinite(dU.real) and math.isfinite(dU.imag)):
+            dU = 0j
         r = abs(z)
         rr = r * r
         whirl = (z.real * v.imag - z.imag * v.real) / rr if rr > 0.0 else (
             ((z.real * v.imag - z.imag * v.real) / r) / r if r > 0.0 else 0.0)
-        F_amb = a * (p.bias_force - p.c * v - p.k * z)
+        F_amb = a * (self._bias_force - p.c * v - p.k * z)
         return (
-            z.real, z.imag, v.real, v.imag, r / c_r, U.real, U.imag,
+            z.real, z.imag, v.real, v.imag, r / c_r, U.real / c_r, U.imag / c_r,
             dU.real, dU.imag, -psi if psi == -math.pi else psi, whirl,
             p.R * W + c_r * whirl, F_amb.real, F_amb.imag,
             W, mode, self._n_impacts, self._t_last, self._v_last, self._E_diss,
@@ -356,6 +361,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """New held inputs (or parameters): rebuild the flight and wall models."""
         self._inputs: tuple[float, complex, float] = (W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
+        self._bias_force = self._p.bias_force  # (N; output_values, every FMU step)
         self._imb_free_h = math.nan  # FlightSteps._imb_flight: for this flight model
         self._imb_seen_h = math.nan
         self._imb_free: tuple[complex, complex, complex, float] = (0j, 0j, 0j, 0.0)

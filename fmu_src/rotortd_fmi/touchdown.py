@@ -97,7 +97,6 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._seen_tunables: tuple | None = None
         self._seen_inputs: tuple | None = None
         self._h_spin_warned = False  # h_spin is deprecated: warned once if set
-        self._state_outputs: tuple[float, ...] = ()  # the last published state outputs
 
     def _watched_setter(self, name: str) -> Any:
         """FMI setter of a parameter or input: stores the value and marks the values as
@@ -131,7 +130,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             raise ModelError(f"cross-parameter constraint: {exc}") from exc
         self._fixed_snapshot = self._fixed_values()
         self._publish_state(self._input_values()[0], float(self.amb_on))
-        self._publish_step_outputs(None, 0)
+        self._publish_step_outputs(None)
 
     def _make_core(self, rotortd: Any) -> Any:
         """The core on the steady whirl or at (x0, y0, vx0, vy0); a start within a few ulp
@@ -246,21 +245,20 @@ class RotorTouchdownAdapter(GuardedSlave):
             raise ModelError(f"communication step size {step_size!r} s must be finite "
                              f"and > 0")
         tol = _time_tolerance(current_time, step_size)
-        if not abs(current_time - core.t) <= tol:  # also refuses a NaN or infinite time
+        t = core.t
+        if not abs(current_time - t) <= tol:  # also refuses a NaN or infinite time
             raise ModelError(f"communication point {current_time!r} does not match the "
-                             f"model time {core.t!r}")
+                             f"model time {t!r}")
         omega, f_ext, amb, t_drive = self._step_inputs  # validated by _check_changes
-        t_target = core.t + step_size
+        t_target = t + step_size
         if core.SPIN_STATE:
             rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
         else:
-            rep = core.step(step_size, omega, F_ext=f_ext, amb_on=amb)
+            rep = core.step(step_size, omega, f_ext, amb)
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
-        self._publish_state(None, amb)  # (the spin: the held input or the core's state)
-        self._publish_step_outputs(rep, len(rep.impacts))
-        total = (sum(self._state_outputs) + rep.F_contact.real + rep.F_contact.imag
-                 + rep.F_n + rep.F_n_peak + rep.P_n + rep.T_f + rep.T_imb)
+        # (the spin: the held input or the core's state)
+        total = self._publish_state(None, amb) + self._publish_step_outputs(rep)
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
         if rep.status == 0 and abs(core.t - t_target) <= tol:
@@ -292,25 +290,36 @@ class RotorTouchdownAdapter(GuardedSlave):
         return True
 
     # ------------------------------------------------------------------ publishing
-    def _publish_state(self, omega: float | None, amb: float) -> None:
+    def _publish_state(self, omega: float | None, amb: float) -> float:
         """Publish what the state shows (``TouchdownCore.output_values``: kinematics, spin
-        speed, mode, counters) for the spin speed omega (None: the core's own) and amb."""
-        self._state_outputs = out = self._core.output_values(omega, amb)
+        speed, mode, counters) for the spin speed omega (None: the core's own) and amb;
+        return their sum (inf or NaN if any is)."""
+        out = self._core.output_values(omega, amb)
         (self.x, self.y, self.vx, self.vy, self.r_rel, self.u_re, self.u_im, self.du_re,
          self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x, self.F_amb_y,
          self.Omega_out, self.mode, self.n_impacts, self.t_last_impact, self.v_last_impact,
          self.E_diss) = out
         self.in_contact = self.mode != 0
+        return sum(out)
 
-    def _publish_step_outputs(self, rep: Any, n_step: int) -> None:
+    def _publish_step_outputs(self, rep: Any) -> float:
+        """Publish what the step report shows (its averages, its impact count; zeros before
+        the first step, rep None); return the sum of the averages (inf or NaN if any is)."""
         if rep is None:
             self.F_bx = self.F_by = self.F_n = self.F_n_peak = self.P_n = self.T_f = 0.0
             self.T_imb = 0.0
-        else:
-            self.F_bx, self.F_by = rep.F_contact.real, rep.F_contact.imag
-            self.F_n, self.F_n_peak, self.P_n, self.T_f = rep.F_n, rep.F_n_peak, rep.P_n, rep.T_f
-            self.T_imb = rep.T_imb
-        self.n_impacts_step = n_step
+            self.n_impacts_step = 0
+            return 0.0
+        F = rep.F_contact
+        self.F_bx = fx = F.real
+        self.F_by = fy = F.imag
+        self.F_n = F_n = rep.F_n
+        self.F_n_peak = peak = rep.F_n_peak
+        self.P_n = P_n = rep.P_n
+        self.T_f = T_f = rep.T_f
+        self.T_imb = T_imb = rep.T_imb
+        self.n_impacts_step = len(rep.impacts)
+        return fx + fy + F_n + peak + P_n + T_f + T_imb
 
     def _append_impacts(self, impacts: list[Any]) -> None:
         with self._open_impact_log() as fh:
