@@ -1,6 +1,7 @@
 """Deterministic cost figures: instructions counted by valgrind's callgrind.
 
     apt-get install valgrind && python docs/scripts/bench_instructions.py   # ~5 min
+    python docs/scripts/bench_instructions.py --base <commit>                # ~6 min
 
 Timed ratios on a shared machine scatter (docs/benchmarks.md). Instruction counts do not,
 so this script counts them for the ratios that sit near their goals:
@@ -20,10 +21,28 @@ fixed hash seed, so the interpreter's start-up and the imports cancel (with rand
 seeds, dict layouts moved a 200-step run by 14M instructions; with a fixed one, by 0.1M).
 The child processes import only FMPy or the core, never numpy or this script's module, to
 keep that start-up small. Prints a table and writes docs/bench_instructions.json.
+
+``--base C`` counts the same figures, DOP853's left out, for commit C and for the current
+tree (with its uncommitted changes), one after the other in the same run, and judges each
+figure against "no worse than before within 2 %" (head <= base * 1.02). C is checked out
+in a temporary ``git worktree add --detach`` (fingerprint.py's add_worktree, removed at the
+end). Per tree: both FMUs are built into the temporary directory by that tree's own
+``benchmarks.build_fmus`` (its build.py, its floor FMU, its variables) in a child process,
+and every child runs with ``PYTHONPATH=<tree>/fmu_src`` (fingerprint.py's tree_env), the
+core child with ``<tree>/fmu_src`` first on sys.path, so the editable install does not
+win; a sanity check prints where each tree's core child and RotorTouchdown FMU imported
+``rotortd`` from, and stops unless it is that tree's fmu_src or the FMU's resources copied
+from it. The scenes are made once, here, from the current tree and handed to both. With
+--base the children also run with ``OPENBLAS_NUM_THREADS=1``: FMPy imports numpy, whose
+OpenBLAS worker threads spin for a time-dependent number of instructions (a 0-step FMU run
+scattered by 40M instructions, 10k per step in the 4000-step difference; single-threaded,
+by 5k instructions). Prints the table (figure, base, head, head/base - 1, verdict) and writes
+docs/bench_instructions_base.json with both commits' hashes; exit 1 if a figure is worse.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import pickle
@@ -39,9 +58,18 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import benchmarks as B  # noqa: E402 (docs/scripts/benchmarks.py: scenes, FMU builds)
+import fingerprint as FP  # noqa: E402 (docs/scripts/fingerprint.py: base worktree, env)
 
 OUT = B.ROOT / "docs" / "bench_instructions.json"
-
+OUT_BASE = B.ROOT / "docs" / "bench_instructions_base.json"
+TOLERANCE = 0.02
+"""--base: a figure passes if head <= base * (1 + TOLERANCE)."""
+SINGLE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+ORIGIN = "origin"
+"""Extra last argument of the FMU and core children (spelt out in their text): print where
+rotortd came from."""
+MEASURED = ("fmu_src", "build.py", "docs/scripts/benchmarks.py")
+"""--base: the head's sources whose uncommitted changes the result records."""
 FMU_CHILD = '''
 import pickle, sys
 from fmpy.fmi2 import FMU2Slave
@@ -67,6 +95,8 @@ for j in range(n):
     fmu.getBoolean(bv)
 fmu.terminate()
 fmu.freeInstance()
+if sys.argv[-1] == "origin":
+    print(sys.modules["rotortd"].__file__)
 '''
 
 CORE_CHILD = '''
@@ -84,6 +114,8 @@ for _ in range(n):
         for _ in range(round((t_end - t) / h)):
             core.step(h, omega, force, amb)
         t = t_end
+if sys.argv[-1] == "origin":
+    print(sys.modules["rotortd"].__file__)
 '''
 
 DOP_CHILD = '''
@@ -99,25 +131,41 @@ for _ in range(n):
 '''
 
 
-def instructions(script: Path, *args: str) -> int:
-    """Instructions callgrind counts for one run of ``python script args``."""
+BUILD_CHILD = '''
+import json, sys
+from pathlib import Path
+sys.path.insert(0, sys.argv[1])
+import benchmarks
+fmus = benchmarks.build_fmus(Path(sys.argv[2]))
+Path(sys.argv[3]).write_text(json.dumps({k: str(u) for k, (u, _md) in fmus.items()}))
+'''
+
+
+Env = dict[str, str]
+
+
+def instructions(script: Path, *args: str, env: Env | None = None) -> int:
+    """Instructions callgrind counts for one run of ``python script args``; ``env`` replaces
+    the environment (default: this one's)."""
     cmd = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
            sys.executable, str(script), *args]
-    env = {**os.environ, "PYTHONHASHSEED": "0"}  # else dict layouts, and counts, vary
+    env = {**(os.environ if env is None else env),
+           "PYTHONHASHSEED": "0"}  # else dict layouts, and counts, vary
     err = subprocess.run(cmd, capture_output=True, text=True, check=True, env=env).stderr
     return int(re.search(r"Collected : (\d+)", err).group(1))
 
 
-def per_unit(script: Path, args: list[str], n_short: int, n_long: int) -> float:
+def per_unit(script: Path, args: list[str], n_short: int, n_long: int,
+             env: Env | None = None) -> float:
     """Instructions per unit of the last argument: (I(n_long) - I(n_short)) / difference."""
-    lo = instructions(script, *args, str(n_short))
-    hi = instructions(script, *args, str(n_long))
+    lo = instructions(script, *args, str(n_short), env=env)
+    hi = instructions(script, *args, str(n_long), env=env)
     return (hi - lo) / (n_long - n_short)
 
 
-def fmu_tables(tmp: Path, scenes: dict[str, B.Scene]) -> Path:
-    """Build both FMUs into tmp and pickle what the FMU child needs."""
-    fmus = B.build_fmus(tmp)
+def fmu_tables(tmp: Path, scenes: dict[str, B.Scene], fmus: dict[str, tuple[str, Any]]) -> Path:
+    """Pickle what the FMU child needs of both FMUs (name -> (unzip dir, model description))
+    and the scenes' start values."""
     data: dict[str, Any] = {"outputs": (B.REAL_OUT, B.INT_OUT, B.BOOL_OUT)}
     for key, (unzip, md) in (("fmu", fmus["RotorTouchdown"]),
                              ("floor", fmus["RotorTouchdownFloor"])):
@@ -131,9 +179,10 @@ def fmu_tables(tmp: Path, scenes: dict[str, B.Scene]) -> Path:
     return path
 
 
-def core_tables(tmp: Path, scenes: dict[str, B.Scene]) -> Path:
-    """Pickle the scenes' parameters, starts and held-input segments for the core child."""
-    data: dict[str, Any] = {"src": str(B.ROOT / "fmu_src"), "root": str(B.ROOT)}
+def core_tables(tmp: Path, scenes: dict[str, B.Scene], tree: Path = B.ROOT) -> Path:
+    """Pickle the scenes' parameters, starts and held-input segments for the core child,
+    which imports ``tree``'s core."""
+    data: dict[str, Any] = {"src": str(tree / "fmu_src"), "root": str(tree)}
     for name, sc in scenes.items():
         p, c_r, rtol = sc.params, sc.params.c_r, 1e-12
         data[name] = {"params": {f: getattr(p, f) for f in p.__dataclass_fields__},
@@ -145,46 +194,219 @@ def core_tables(tmp: Path, scenes: dict[str, B.Scene]) -> Path:
     return path
 
 
-def main() -> int:
+def write_children(tmp: Path) -> dict[str, Path]:
+    """The child scripts in tmp: fmu, core, dop, build."""
+    texts = {"fmu": FMU_CHILD, "core": CORE_CHILD, "dop": DOP_CHILD, "build": BUILD_CHILD}
+    paths = {k: tmp / f"{k}_child.py" for k in texts}
+    for k, path in paths.items():
+        path.write_text(texts[k])
+    return paths
+
+
+def count_fmu_steps(child: Path, pkl: Path, env: Env | None = None) -> dict[str, Any]:
+    """Instructions per FMU step, RotorTouchdown and floor, on the free whirl and the
+    limit cycle."""
+    out: dict[str, Any] = {}
+    for scene, goal in (("free_whirl", 1.2), ("limit_cycle", 1.5)):
+        fmu, floor = (per_unit(child, [str(pkl), w, scene], 200, 4200, env)
+                      for w in ("fmu", "floor"))
+        out[scene] = {"fmu": fmu, "floor": floor, "ratio": fmu / floor, "goal": goal}
+        print(f"{scene:12s} per FMU step: RotorTouchdown {fmu / 1e3:7.1f}k, floor "
+              f"{floor / 1e3:7.1f}k instructions, ratio {fmu / floor:.3f} (goal <= {goal})",
+              flush=True)
+    return out
+
+
+def count_core(child: Path, pkl: Path, env: Env | None = None) -> dict[str, float]:
+    """Instructions of the core per simulated second, per scene and call mode."""
+    out: dict[str, float] = {}
+    for scene in ("limit_cycle", "chattering"):
+        for mode in ("seg", "0.1", "1e-3"):
+            per_s = per_unit(child, [str(pkl), scene, mode], 1, 3, env)
+            out[f"{scene} {mode}"] = per_s
+            print(f"{scene:12s} core, {mode:>4s} calls: {per_s / 1e6:6.1f}M instructions "
+                  "per simulated second", flush=True)
+    return out
+
+
+def count_tree(children: dict[str, Path], fmu_pkl: Path, core_pkl: Path,
+               env: Env | None = None) -> dict[str, Any]:
+    """Every figure but DOP853's for the FMUs and core the pickles point to."""
+    out: dict[str, Any] = {"fmu_step": count_fmu_steps(children["fmu"], fmu_pkl, env),
+                           "core_per_second": count_core(children["core"], core_pkl, env)}
+    cps = out["core_per_second"]
+    ratio = cps["chattering 1e-3"] / cps["limit_cycle 1e-3"]
+    out["chattering_vs_limit_cycle_core_1e-3"] = ratio
+    print(f"chattering / limit cycle, core at 1e-3 s steps: {ratio:.2f} (goal <= 3)")
+    return out
+
+
+def count_dop(child: Path, core_pkl: Path, cps: dict[str, float]) -> dict[str, Any]:
+    """DOP853 on the limit cycle and its ratio to the core's figures ``cps``."""
+    dop = per_unit(child, [str(core_pkl), "limit_cycle"], 1, 2)
+    vs = {m: dop / cps[f"limit_cycle {m}"] for m in ("seg", "0.1", "1e-3")}
+    print(f"DOP853 at rtol 1e-12, limit cycle: {dop / 1e6:.0f}M instructions; DOP853 / core: "
+          + ", ".join(f"{v:.1f} ({m} calls)" for m, v in vs.items()) + " (goal >= 50)")
+    return {"dop853_limit_cycle": dop, "dop853_vs_core": vs}
+
+
+def run_head(tmp: Path, scenes: dict[str, B.Scene]) -> int:
+    """No --base: this tree's figures with DOP853's, to docs/bench_instructions.json."""
+    children = write_children(tmp)
+    fmu_pkl = fmu_tables(tmp, scenes, B.build_fmus(tmp))
+    core_pkl = core_tables(tmp, scenes)
+    out = {"machine": B.machine(), **count_tree(children, fmu_pkl, core_pkl)}
+    out.update(count_dop(children["dop"], core_pkl, out["core_per_second"]))
+    OUT.write_text(json.dumps(out, indent=1) + "\n")
+    print(f"wrote {OUT}")
+    return 0
+
+
+# ------------------------------------------------------------------------------ --base
+
+
+def tree_fmus(tree: Path, work: Path, build_child: Path) -> dict[str, tuple[str, Any]]:
+    """Both FMUs built into ``work`` by ``tree``'s own benchmarks.build_fmus, in a child
+    with the tree's environment; name -> (unzip dir, model description)."""
+    from fmpy import read_model_description
+
+    res = work / "fmus.json"
+    proc = subprocess.run([sys.executable, str(build_child), str(tree / "docs" / "scripts"),
+                           str(work), str(res)], cwd=tree, env=FP.tree_env(tree),
+                          capture_output=True, text=True)
+    if proc.returncode or not res.exists():
+        raise SystemExit(f"FMU build in {tree} failed: {proc.stderr[-2000:]}")
+    unzips = json.loads(res.read_text())
+    return {name: (unzip, read_model_description(unzip)) for name, unzip in unzips.items()}
+
+
+def rotortd_origin(child: Path, args: list[str], env: Env) -> Path:
+    """Where a 0-step run of ``child`` imported rotortd from (also warms any bytecode
+    cache, so the counted runs start alike)."""
+    proc = subprocess.run([sys.executable, str(child), *args, "0", ORIGIN], env=env,
+                          capture_output=True, text=True)
+    if proc.returncode:
+        raise SystemExit(f"{child.name} {args}: {proc.stderr[-2000:]}")
+    return Path(proc.stdout.strip().splitlines()[-1]).parent
+
+
+def same_package(copy: Path, src: Path) -> bool:
+    """Every .py of package ``src`` is in ``copy`` with the same bytes."""
+    return all((copy / f.name).exists() and (copy / f.name).read_bytes() == f.read_bytes()
+               for f in src.glob("*.py"))
+
+
+def check_origins(tree: Path, children: dict[str, Path], fmu_pkl: Path, core_pkl: Path,
+                  env: Env) -> None:
+    """Stop unless the core child imports ``tree``'s rotortd and the FMU a copy of it."""
+    src = tree / "fmu_src" / "rotortd"
+    core = rotortd_origin(children["core"], [str(core_pkl), "limit_cycle", "seg"], env)
+    fmu = rotortd_origin(children["fmu"], [str(fmu_pkl), "fmu", "free_whirl"], env)
+    print(f"rotortd of {tree}: core child {core}, FMU {fmu}", flush=True)
+    if core.resolve() != src.resolve():
+        raise SystemExit(f"the core child imported rotortd from {core}, not {src}")
+    if not same_package(fmu, src):
+        raise SystemExit(f"the FMU's rotortd ({fmu}) is not a copy of {src}")
+
+
+def count_in_tree(tree: Path, work: Path, scenes: dict[str, B.Scene]) -> dict[str, Any]:
+    """Every figure but DOP853's for ``tree``, its FMUs built and its children run in
+    ``work``."""
+    work.mkdir(parents=True)
+    children = write_children(work)
+    env = {**FP.tree_env(tree), **SINGLE_THREAD}
+    fmu_pkl = fmu_tables(work, scenes, tree_fmus(tree, work, children["build"]))
+    core_pkl = core_tables(work, scenes, tree)
+    check_origins(tree, children, fmu_pkl, core_pkl, env)
+    return count_tree(children, fmu_pkl, core_pkl, env)
+
+
+def git(*args: str) -> str:
+    return subprocess.run(["git", "-C", str(B.ROOT), *args], capture_output=True, text=True,
+                          check=True).stdout.strip()
+
+
+def figures(res: dict[str, Any]) -> dict[str, float]:
+    """The compared figures of one tree's counts, by name."""
+    out = {}
+    for scene, d in res["fmu_step"].items():
+        out.update({f"FMU step {scene} {k}": d[k] for k in ("fmu", "floor", "ratio")})
+    out.update({f"core/s {k}": v for k, v in res["core_per_second"].items()})
+    out["core chattering/limit_cycle 1e-3"] = res["chattering_vs_limit_cycle_core_1e-3"]
+    return out
+
+
+def compare(base: dict[str, Any], head: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Per figure: base, head, head/base - 1, and whether head <= base * (1 + TOLERANCE)."""
+    fb, fh = figures(base), figures(head)
+    return {k: {"base": fb[k], "head": fh[k], "change": fh[k] / fb[k] - 1,
+                "ok": fh[k] <= fb[k] * (1 + TOLERANCE)} for k in fb}
+
+
+def fmt(name: str, value: float) -> str:
+    """A figure for the table: per-step counts in k, per-second counts in M."""
+    if name.endswith(("fmu", "floor")):
+        return f"{value / 1e3:.1f}k"
+    if name.startswith("core/s"):
+        return f"{value / 1e6:.2f}M"
+    return f"{value:.4f}"
+
+
+def print_comparison(rows: dict[str, dict[str, Any]], base: str, head: str) -> None:
+    print(f"\ninstructions, base {base} vs head {head}; verdict: head <= base * "
+          f"{1 + TOLERANCE:g}")
+    print(f"{'figure':36s} {'base':>10s} {'head':>10s} {'head/base-1':>11s}  verdict")
+    for k, r in rows.items():
+        print(f"{k:36s} {fmt(k, r['base']):>10s} {fmt(k, r['head']):>10s} "
+              f"{100 * r['change']:+10.2f}%  {'ok' if r['ok'] else 'WORSE'}")
+
+
+def run_base(commit: str, tmp: Path, scenes: dict[str, B.Scene]) -> int:
+    """--base: both trees' figures, compared, to docs/bench_instructions_base.json."""
+    base_hash = git("rev-parse", "--verify", f"{commit}^{{commit}}")
+    head_hash = git("rev-parse", "HEAD")
+    dirty = git("status", "--porcelain", "--", *MEASURED)
+    base_tree = tmp / "base_tree"
+    FP.add_worktree(base_hash, base_tree)
+    try:
+        res = {}
+        for key, tree in (("base", base_tree), ("head", B.ROOT)):
+            print(f"--- {key}: {tree}", flush=True)
+            res[key] = count_in_tree(tree, tmp / key, scenes)
+    finally:
+        FP.remove_worktree(base_tree)
+    rows = compare(res["base"], res["head"])
+    out = {"machine": B.machine(), "criterion": f"head <= base * {1 + TOLERANCE:g}",
+           "base": {"commit": base_hash, **res["base"]},
+           "head": {"commit": head_hash, "uncommitted_sources": dirty.splitlines(),
+                    **res["head"]},
+           "env": SINGLE_THREAD, "figures": rows}
+    OUT_BASE.write_text(json.dumps(out, indent=1) + "\n")
+    print_comparison(rows, base_hash[:7], head_hash[:7] + ("+" if dirty else ""))
+    print(f"wrote {OUT_BASE}")
+    return 0 if all(r["ok"] for r in rows.values()) else 1
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--base", metavar="COMMIT",
+                    help="count COMMIT and the current tree and judge each figure against "
+                         f"head <= base * {1 + TOLERANCE:g}; the DOP853 figures are skipped; "
+                         "writes docs/bench_instructions_base.json")
+    return ap.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
     if shutil.which("valgrind") is None:
         print("valgrind not found: apt-get install valgrind", file=sys.stderr)
         return 2
     scenes = {sc.name: sc for sc in B.make_scenes()}
     tmp = Path(tempfile.mkdtemp(prefix="bench_instr_"))
-    fmu_child, core_child, dop_child = (tmp / f"{k}_child.py" for k in ("fmu", "core", "dop"))
-    fmu_child.write_text(FMU_CHILD)
-    core_child.write_text(CORE_CHILD)
-    dop_child.write_text(DOP_CHILD)
-    fmu_pkl, core_pkl = fmu_tables(tmp, scenes), core_tables(tmp, scenes)
-    out: dict[str, Any] = {"machine": B.machine(), "fmu_step": {}, "core_per_second": {}}
-    for scene, goal in (("free_whirl", 1.2), ("limit_cycle", 1.5)):
-        fmu, floor = (per_unit(fmu_child, [str(fmu_pkl), w, scene], 200, 4200)
-                      for w in ("fmu", "floor"))
-        out["fmu_step"][scene] = {"fmu": fmu, "floor": floor, "ratio": fmu / floor,
-                                  "goal": goal}
-        print(f"{scene:12s} per FMU step: RotorTouchdown {fmu / 1e3:7.1f}k, floor "
-              f"{floor / 1e3:7.1f}k instructions, ratio {fmu / floor:.3f} (goal <= {goal})",
-              flush=True)
-    for scene in ("limit_cycle", "chattering"):
-        for mode in ("seg", "0.1", "1e-3"):
-            per_s = per_unit(core_child, [str(core_pkl), scene, mode], 1, 3)
-            out["core_per_second"][f"{scene} {mode}"] = per_s
-            print(f"{scene:12s} core, {mode:>4s} calls: {per_s / 1e6:6.1f}M instructions "
-                  "per simulated second", flush=True)
-    cps = out["core_per_second"]
-    ratio = cps["chattering 1e-3"] / cps["limit_cycle 1e-3"]
-    out["chattering_vs_limit_cycle_core_1e-3"] = ratio
-    print(f"chattering / limit cycle, core at 1e-3 s steps: {ratio:.2f} (goal <= 3)")
-    dop = per_unit(dop_child, [str(core_pkl), "limit_cycle"], 1, 2)
-    out["dop853_limit_cycle"] = dop
-    out["dop853_vs_core"] = {m: dop / cps[f"limit_cycle {m}"] for m in ("seg", "0.1", "1e-3")}
-    print(f"DOP853 at rtol 1e-12, limit cycle: {dop / 1e6:.0f}M instructions; DOP853 / core: "
-          + ", ".join(f"{v:.1f} ({m} calls)" for m, v in out["dop853_vs_core"].items())
-          + " (goal >= 50)")
-    OUT.write_text(json.dumps(out, indent=1) + "\n")
-    print(f"wrote {OUT}")
-    shutil.rmtree(tmp, ignore_errors=True)
-    return 0
+    try:
+        return run_base(args.base, tmp, scenes) if args.base else run_head(tmp, scenes)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 if __name__ == "__main__":
