@@ -10,7 +10,10 @@ so this script counts them for the ratios that sit near their goals:
   benchmarks.py (doStep at 1e-3 s, all outputs read every step), on the free whirl and
   the limit cycle;
 - instructions of the core alone per simulated second of the limit-cycle and chattering
-  scenes, in one call per held-input segment, in 0.1 s calls and in 1e-3 s steps;
+  scenes, in one call per held-input segment, in 0.1 s calls and in 1e-3 s steps, with the
+  held-speed imbalance torque off (``TouchdownCore.imbalance_torque = False``: the
+  motion's cost, as a core before T_imb had it; ``--imbalance-torque`` turns it on; the FMU
+  figures always compute it, T_imb being an output);
 - instructions of DOP853 at rtol 1e-12 (tests/reference/direct.py, as benchmarks.py runs
   it) on the limit cycle, for the core-vs-DOP853 target. DOP853 spends part of its time in
   numpy's C loops, where an instruction is cheaper than in the interpreter, so this ratio
@@ -32,8 +35,8 @@ and every child runs with ``PYTHONPATH=<tree>/fmu_src`` (fingerprint.py's tree_e
 core child with ``<tree>/fmu_src`` first on sys.path, so the editable install does not
 win; a sanity check prints where each tree's core child and RotorTouchdown FMU imported
 ``rotortd`` from, and stops unless it is that tree's fmu_src or the FMU's resources copied
-from it. The scenes are made once, here, from the current tree and handed to both. With
---base the children also run with ``OPENBLAS_NUM_THREADS=1``: FMPy imports numpy, whose
+from it. The scenes are made once, here, from the current tree and handed to both. The
+children run with ``OPENBLAS_NUM_THREADS=1``: FMPy imports numpy, whose
 OpenBLAS worker threads spin for a time-dependent number of instructions (a 0-step FMU run
 scattered by 40M instructions, 10k per step in the 4000-step difference; single-threaded,
 by 5k instructions). Prints the table (figure, base, head, head/base - 1, verdict) and writes
@@ -100,14 +103,17 @@ if sys.argv[-1] == "origin":
 '''
 
 CORE_CHILD = '''
-import pickle, sys
+import os, pickle, sys
 D = pickle.load(open(sys.argv[1], "rb"))
 sys.path.insert(0, D["src"])
 from rotortd import RotorParams, TouchdownCore
 sc, mode, n = D[sys.argv[2]], sys.argv[3], int(sys.argv[4])
 p = RotorParams(**sc["params"])
+imb = os.environ.get("BENCH_IMBALANCE_TORQUE") == "1"
 for _ in range(n):
     core = TouchdownCore(p, sc["z0"], sc["v0"], sc["psi0"])
+    if hasattr(core, "imbalance_torque"):  # (a core before it had no T_imb at all)
+        core.imbalance_torque = imb
     t = 0.0
     for t_end, omega, force, amb in sc["segments"]:
         h = t_end - t if mode == "seg" else float(mode)
@@ -255,7 +261,8 @@ def run_head(tmp: Path, scenes: dict[str, B.Scene]) -> int:
     children = write_children(tmp)
     fmu_pkl = fmu_tables(tmp, scenes, B.build_fmus(tmp))
     core_pkl = core_tables(tmp, scenes)
-    out = {"machine": B.machine(), **count_tree(children, fmu_pkl, core_pkl)}
+    env = {**os.environ, **SINGLE_THREAD}
+    out = {"machine": B.machine(), **count_tree(children, fmu_pkl, core_pkl, env)}
     out.update(count_dop(children["dop"], core_pkl, out["core_per_second"]))
     OUT.write_text(json.dumps(out, indent=1) + "\n")
     print(f"wrote {OUT}")
@@ -393,11 +400,17 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="count COMMIT and the current tree and judge each figure against "
                          f"head <= base * {1 + TOLERANCE:g}; the DOP853 figures are skipped; "
                          "writes docs/bench_instructions_base.json")
+    ap.add_argument("--imbalance-torque", action="store_true",
+                    help="the core-alone figures with the held-speed imbalance torque "
+                         "computed (TouchdownCore.imbalance_torque; default off there: the "
+                         "motion's cost, comparable with a core that had no T_imb). The FMU "
+                         "figures always compute it (T_imb is an output)")
     return ap.parse_args(argv)
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    os.environ["BENCH_IMBALANCE_TORQUE"] = "1" if args.imbalance_torque else "0"
     if shutil.which("valgrind") is None:
         print("valgrind not found: apt-get install valgrind", file=sys.stderr)
         return 2

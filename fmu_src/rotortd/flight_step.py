@@ -43,6 +43,7 @@ ETA_TIME = 1e-3
 N_CASCADE = 1000
 """Rule (2) applies when more than N_CASCADE impacts would remain before rule (1)."""
 _R_CLEAR = 1.0 - 1e-9
+NAN, INF = math.nan, math.inf
 
 
 class FlightSteps:
@@ -55,7 +56,7 @@ class FlightSteps:
         caller searches). Either way the step ends in the same state as a search that finds
         nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
-        E = self._phasor()
+        E = cmath.exp(1j * self._psi)  # (_phasor, inline: the quiet step)
         work = 1
         if not self._clear:
             if self._on_wall:
@@ -78,7 +79,7 @@ class FlightSteps:
         else:
             rep.P_imb = P = self._imb_flight(z0, v0, E, h)
             rep.T_imb = P / h
-        self._advance_psi(h)
+        self._add_psi(self._inputs[0] * h)  # (_advance_psi, inline)
         self._on_wall = False
         rep.work = work
         return True
@@ -253,7 +254,8 @@ class Flight:
             loc = ContactLocator(fm, self.z0, self.v0, self.E)
             hit = loc.find(rem, self.on_wall, work, limit)
         if hit is not None:
-            return SegmentEnd(hit.s, event=hit.kind, z=hit.z, v=hit.v, work=work.total)
+            return SegmentEnd(hit.s, NAN, NAN, hit.kind, None, INF, hit.z, hit.v, NAN, NAN,
+                              work.total)  # (positional: a flight's end, cheaper)
         if loc is not None and self.resumed:
             # the rest of a step after an event: a length that will not recur, whose
             # flight map costs twelve times the search's modal state (measured)
@@ -261,7 +263,7 @@ class Flight:
         else:  # a whole step: its length recurs and its flight map is cached
             work.evals += 1
             z, v = fm.propagate(self.z0, self.v0, self.E, rem, cache=not self.resumed)
-        return SegmentEnd(rem, z=z, v=v, work=work.total)
+        return SegmentEnd(rem, NAN, NAN, None, None, INF, z, v, NAN, NAN, work.total)
 
 
 def starts_contact(A: float, vb: float, d: float, c_r: float,

@@ -38,7 +38,7 @@ class Impact:
     E_diss: float
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Reset:
     """Result of the reset law at a point on the circle (SI, inertial)."""
 

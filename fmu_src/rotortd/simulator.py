@@ -280,12 +280,13 @@ class TouchdownCore(FlightSteps, ContactSteps):
         A step that would need more stops where it is with STATUS_WORK_CAP and a message
         saying where (docs/model.md 7)."""
         F = complex(F_ext)
-        if not (0.0 < h < math.inf and math.isfinite(Omega) and 0.0 <= amb_on <= 1.0
-                and math.isfinite(F.real) and math.isfinite(F.imag)):
+        if (Omega, F, amb_on) != self._inputs:  # new held inputs (NaN never equals)
+            if not (math.isfinite(Omega) and 0.0 <= amb_on <= 1.0
+                    and math.isfinite(F.real) and math.isfinite(F.imag)):
+                self._reject_inputs(h, Omega, F, amb_on)
+            self._set_inputs(float(Omega), F, float(amb_on))
+        if not 0.0 < h < math.inf:
             self._reject_inputs(h, Omega, F, amb_on)
-        W, a = float(Omega), float(amb_on)
-        if (W, F, a) != self._inputs:
-            self._set_inputs(W, F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
         rep = StepReport(work_cap=cap)
         t0, s = self._t, h

@@ -115,13 +115,16 @@ class Sliding:
                        n: int) -> list[float]:
         """gbs.midpoint(self.rhs, u0, y0, f0, H, n), fused: the same floating-point
         operations (bit-identical, checked by a test) on scalars instead of lists, which
-        halves the cost of the sliding integrator. u0, H in s; y as in ``rhs``."""
+        halves the cost of the sliding integrator. u0, H in s; y as in ``rhs``. Without
+        ``aux`` the quadrature Z (y[6], y[7]) is not advanced (its right-hand side is not
+        evaluated): the other components are the same to the last bit."""
         wf = self.wf
         q0, eu, E0, iW, W, kappa, beta, wr, mus, nu = (
             wf.q0, wf.eu, self.E0, 1j * wf.Omega, wf.Omega, wf.kappa, wf.beta, wf.wr,
             self.mus, self.nu,
         )
         exp, cos, sin = cmath.exp, math.cos, math.sin
+        aux, f6, f7 = self.aux, 0.0, 0.0  # without aux, Z (y[6], y[7]) is left as it is
         try:  # an overflowing trial step (cos(inf)) is rejected by its NaN error ratio
             h = H / n
             h2 = 2.0 * h
@@ -146,8 +149,9 @@ class Sliding:
                     br, bi = ar - mus * ai, ai + mus * ar
                     f3, f4 = bi * sn - br * co, -(br * sn) - bi * co
                 f5 = ft * (wr + c1)
-                rr, ri = rot.real, rot.imag
-                f6, f7 = co * rr + sn * ri, sn * rr - co * ri
+                if aux:
+                    rr, ri = rot.real, rot.imag
+                    f6, f7 = co * rr + sn * ri, sn * rr - co * ri
                 if i == n:
                     break
                 m0, c0 = c0, m0 + h2 * c1
@@ -156,8 +160,9 @@ class Sliding:
                 m3, c3 = c3, m3 + h2 * f3
                 m4, c4 = c4, m4 + h2 * f4
                 m5, c5 = c5, m5 + h2 * f5
-                m6, c6 = c6, m6 + h2 * f6
-                m7, c7 = c7, m7 + h2 * f7
+                if aux:
+                    m6, c6 = c6, m6 + h2 * f6
+                    m7, c7 = c7, m7 + h2 * f7
             return [
                 0.5 * (c0 + m0 + h * c1),
                 0.5 * (c1 + m1 + h * f1),

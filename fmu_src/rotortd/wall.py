@@ -102,7 +102,7 @@ class WallForces:
         )
 
 
-@dataclass
+@dataclass(slots=True)
 class ContactTally:
     """Integrals of the contact force over a segment, per unit m c_r (SI otherwise).
 
