@@ -167,12 +167,7 @@ class SpinFlight:
         *,
         force_integration: bool = False,
     ) -> None:
-        if not (J > 0.0 and math.isfinite(J)):
-            raise ValueError(f"J = {J!r} kg m^2: it must be finite and > 0")
-        for name, x in (("a", a), ("F_ext", F_ext), ("T_drive", T_drive), ("z", z),
-                        ("v", v), ("psi", psi), ("Omega", Omega)):
-            if not cmath.isfinite(complex(x)):
-                raise ValueError(f"{name} = {x!r} is not finite")
+        _check_finite(J, a=a, F_ext=F_ext, T_drive=T_drive, z=z, v=v, psi=psi, Omega=Omega)
         self.p = p
         self.J = float(J)
         self.a = float(a)
@@ -197,18 +192,7 @@ class SpinFlight:
         self.f0m = self.F0 / self.m - 1j * self.g  # constant part of z_G'' (m/s^2)
         self.f0m_abs = abs(self.f0m)
         self.F0_abs = abs(self.F0)
-        cr = self.cr
-        w = max(
-            abs(self.Om0),
-            abs(self.v0) / cr,
-            math.sqrt(self.kA / self.m),
-            self.cA / self.m,
-            math.sqrt((self.f0m_abs + self.ec * abs(self.Om0) ** 2) / cr),
-            abs(self.alpha) ** 0.5,
-            math.sqrt(self.ec * (self.F0_abs + self.kA * cr) / self.J),
-            1e-9,
-        )
-        self.w = w
+        self.w = w = self._rate_scale()
         self.horizon = HORIZON / w
         self.Om_scale = max(abs(self.Om0), w)
         if self.closed:
@@ -220,6 +204,21 @@ class SpinFlight:
                                     float]] = []
             self._starts: list[float] = []
             self._k = 0  # index of the Taylor step of the last dense point
+
+    def _rate_scale(self) -> float:
+        """The flight's rate scale w (rad/s): the largest of the spin, the speed over c_r,
+        the bearing's rates, the forces' and the drive's."""
+        cr = self.cr
+        return max(
+            abs(self.Om0),
+            abs(self.v0) / cr,
+            math.sqrt(self.kA / self.m),
+            self.cA / self.m,
+            math.sqrt((self.f0m_abs + self.ec * abs(self.Om0) ** 2) / cr),
+            abs(self.alpha) ** 0.5,
+            math.sqrt(self.ec * (self.F0_abs + self.kA * cr) / self.J),
+            1e-9,
+        )
 
     # ---------------------------------------------------------------- trajectory
     def state(self, s: float, work: Work) -> tuple[complex, complex, float, float, complex]:
@@ -594,6 +593,15 @@ class SpinFlight:
                 z = z * (self.cr / r)
         return SegmentEnd(s, event=event, z=z, v=v, psi=self.psi0 + dpsi, Omega=Om,
                           work=work.total)
+
+
+def _check_finite(J: float, **values: complex) -> None:
+    """ValueError unless J (kg m^2) is finite and > 0 and every value is finite."""
+    if not (J > 0.0 and math.isfinite(J)):
+        raise ValueError(f"J = {J!r} kg m^2: it must be finite and > 0")
+    for name, x in values.items():
+        if not cmath.isfinite(complex(x)):
+            raise ValueError(f"{name} = {x!r} is not finite")
 
 
 def _tail_step(a: float, b: float, tol: float, N: int) -> float:
