@@ -120,7 +120,8 @@ class SpinCore(TouchdownCore):
         held = HeldInputs(self._p, self._J, a, F, float(T_drive))
         self._inputs = (self._inputs[0], F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
-        rep = StepReport(work_cap=cap)
+        rep = StepReport()  # (then work_cap: a keyword argument costs 110 ns)
+        rep.work_cap = cap
         t0, W0 = self._t, self._inputs[0]
         st = StepContext(cap)
         st.held = held
