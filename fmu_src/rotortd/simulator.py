@@ -338,8 +338,12 @@ class TouchdownCore(FlightSteps, ContactSteps):
     def _finish(self, rep: StepReport, t0: float, s: float, h: float, tallied: bool) -> None:
         """The one place a step ends: advance the clock to where the step got (s of h) and
         turn the report's impulses into step averages (not after a flight proved free,
-        whose report holds nothing to average)."""
-        self._advance_clock(h if s >= h else s)
+        whose report holds nothing to average). The clock is advanced with compensated
+        summation (Kahan; no drift over 1e6 steps)."""
+        y = (h if s >= h else s) - self._t_lo
+        t = self._t + y
+        self._t_lo = (t - self._t) - y
+        self._t = t
         if tallied:
             self._fill_report(rep, self._t - t0 if s < h else h)
 
@@ -351,13 +355,6 @@ class TouchdownCore(FlightSteps, ContactSteps):
         check_finite("F_x", F.real, InputError)
         check_finite("F_y", F.imag, InputError)
         check_range("amb_on", amb_on, 0.0, 1.0, error=InputError)
-
-    def _advance_clock(self, dt: float) -> None:
-        """Advance the clock by dt with compensated summation (no drift over 1e6 steps)."""
-        y = dt - self._t_lo
-        t = self._t + y
-        self._t_lo = (t - self._t) - y
-        self._t = t
 
     def _set_inputs(self, W: float, F: complex, a: float) -> None:
         """New held inputs (or parameters): rebuild the flight and wall models."""
@@ -405,15 +402,16 @@ class TouchdownCore(FlightSteps, ContactSteps):
         return self._mode, self._z, self._v, self._theta, self._dtheta, self._psi
 
     def _imb_boundary(self, mode: int, z: complex, v: complex, theta: float, dtheta: float,
-                      psi: float) -> float:
+                      psi: float, A: complex | None = None) -> float:
         """B (m^2/s), the identity's boundary term Im(conj(z') A) - Omega Re(conj(z) A),
         A = e^{i(psi + phi)}, of a state: (z, v) in flight; on the wall (mode != 0;
         z = c_r e^{i theta}, z' = i theta' z) B = -(theta' + Omega) c_r cos(psi + phi -
-        theta)."""
+        theta); ``A`` is e^{i(psi + phi)} when the caller has it."""
         W, phi = self._inputs[0], self._p.phi
         if mode:
             return -(dtheta + W) * self._p.c_r * math.cos(psi + phi - theta)
-        A = cmath.exp(1j * (psi + phi))
+        if A is None:
+            A = cmath.exp(1j * (psi + phi))
         return (v.conjugate() * A).imag - W * (z.conjugate() * A).real
 
     def _imb_add(self, rep: StepReport, E: complex, K: complex) -> None:
@@ -429,13 +427,12 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """Add the identity's boundary and gravity terms (N m s) of a step that started in
         ``start`` (``_imb_start``) and lasted dur seconds to P_imb: e_c m (B1 - B0) -
         e_c Im(conj(-i m g) e^{i(psi0 + phi)} int_0^dur e^{i Omega u} du)."""
-        psi0 = start[5]
         p = self._p
-        P = p.m * (self._imb_boundary(*self._imb_start()) - self._imb_boundary(*start))
+        A0 = cmath.exp(1j * (start[5] + p.phi))
+        P = p.m * (self._imb_boundary(*self._imb_start()) - self._imb_boundary(*start, A0))
         if p.g != 0.0:  # conj(-i m g) = i m g: Im(i m g X) = m g Re(X)
             if self._imb_pint[0] != dur:
                 self._imb_pint = (dur, phase_integral(self._inputs[0], dur))
-            A0 = cmath.exp(1j * (psi0 + p.phi))
             P -= p.m * p.g * (A0 * self._imb_pint[1]).real
         rep.P_imb += p.e_c * P
 

@@ -258,7 +258,8 @@ class RotorTouchdownAdapter(GuardedSlave):
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         # (the spin: the held input or the core's state)
-        total = self._publish_state(None, amb) + self._publish_step_outputs(rep)
+        total = (self._publish_state(None, amb, bool(rep.impacts or rep.transitions))
+                 + self._publish_step_outputs(rep))
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
         if rep.status == 0 and abs(core.t - t_target) <= tol:
@@ -290,16 +291,19 @@ class RotorTouchdownAdapter(GuardedSlave):
         return True
 
     # ------------------------------------------------------------------ publishing
-    def _publish_state(self, omega: float | None, amb: float) -> float:
+    def _publish_state(self, omega: float | None, amb: float, events: bool = True) -> float:
         """Publish what the state shows (``TouchdownCore.output_values``: kinematics, spin
         speed, mode, counters) for the spin speed omega (None: the core's own) and amb;
-        return their sum (inf or NaN if any is)."""
+        return their sum (inf or NaN if any is). The mode and the impact counters change
+        only with ``events`` (impacts or mode changes in the step); E_diss also in a
+        contact segment (mode != 0)."""
         out = self._core.output_values(omega, amb)
         (self.x, self.y, self.vx, self.vy, self.r_rel, self.u_re, self.u_im, self.du_re,
          self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x, self.F_amb_y,
-         self.Omega_out, self.mode, self.n_impacts, self.t_last_impact, self.v_last_impact,
-         self.E_diss) = out
-        self.in_contact = self.mode != 0
+         self.Omega_out, mode, n_impacts, t_last, v_last, E_diss) = out
+        if events or mode:
+            self.mode, self.in_contact, self.n_impacts = mode, mode != 0, n_impacts
+            self.t_last_impact, self.v_last_impact, self.E_diss = t_last, v_last, E_diss
         return sum(out)
 
     def _publish_step_outputs(self, rep: Any) -> float:
