@@ -29,7 +29,7 @@ import cmath
 import math
 from collections.abc import Callable
 
-from .events import ContactLocator, Work, flight_is_clear
+from .events import WORK_MAX, ContactLocator, Work, flight_is_clear
 from .flight import FlightModel
 from .impact import Impact, reset
 from .report import StepContext, StepReport
@@ -245,7 +245,7 @@ class Flight:
         self.fm, self.z0, self.v0, self.E = fm, z0, v0, E
         self.on_wall, self.search, self.resumed = on_wall, search, resumed
 
-    def run(self, rem: float, limit: int) -> SegmentEnd:
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Fly at most rem seconds; stop at the first contact ("impact", "touch"), or where
         the search used its advances ("clear"); at most ``limit`` work units of search."""
         fm, work = self.fm, Work()

@@ -36,6 +36,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from . import gbs
+from .events import WORK_MAX
 from .params import RotorParams
 from .wall import ContactTally, ContactWorkExceeded, SegmentEnd
 
@@ -227,7 +228,7 @@ class SpinContact:
         rhs = self.rhs
         return lambda u0, y0, f0, H, n: gbs.midpoint(rhs, u0, y0, f0, H, n)
 
-    def run(self, rem: float, limit: int) -> SegmentEnd:
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
         y = self.y0 + [0.0] * 5
         nq = self.nq

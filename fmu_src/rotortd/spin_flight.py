@@ -93,7 +93,7 @@ import cmath
 import math
 from operator import mul
 
-from .events import Work, safe_step
+from .events import WORK_MAX, Work, safe_step
 from .params import RotorParams
 from .wall import ContactWorkExceeded, SegmentEnd
 
@@ -377,7 +377,7 @@ class SpinFlight:
         return tau, G3, G4
 
     # ---------------------------------------------------------------- search
-    def run(self, rem: float, limit: int) -> SegmentEnd:
+    def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Advance at most ``rem`` s; stop at the first contact; raise ContactWorkExceeded
         (with ``work``) if more than ``limit`` work units would be needed."""
         if not rem >= 0.0:
