@@ -65,6 +65,15 @@ def mp_closed(sc: Scene, t: mp.mpf) -> tuple[mp.mpc, mp.mpc, mp.mpf, mp.mpf]:
     return z, v, psi, Om
 
 
+
+def _horner(coeffs, u):
+    """sum_k coeffs[k] u^k (ascending coefficients) by Horner's rule, as mp.polyval does
+    with descending ones (whose order mpmath 1.4 deprecates)."""
+    r = 0
+    for c in reversed(coeffs):
+        r = r * u + c
+    return r
+
 class MpTaylor:
     """40-digit Taylor integration of the SPEC's free-flight ODE, order 30, dense output."""
 
@@ -116,10 +125,10 @@ class MpTaylor:
     @staticmethod
     def _eval(co, u):
         zc, Oc, ps = co
-        z = mp.polyval(zc[::-1], u)
-        v = mp.polyval([k * zc[k] for k in range(len(zc) - 1, 0, -1)], u)
-        Om = mp.polyval(Oc[::-1], u)
-        psi = mp.polyval(ps[::-1], u)
+        z = _horner(zc, u)
+        v = _horner([k * zc[k] for k in range(1, len(zc))], u)
+        Om = _horner(Oc, u)
+        psi = _horner(ps, u)
         return z, v, psi, Om
 
     def at(self, t):
