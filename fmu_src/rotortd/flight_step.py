@@ -196,14 +196,8 @@ class FlightSteps:
         plastic = self._low_speed_contact(n, r.rdot, r.v_plus)
         if plastic:
             r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)
-        imp = Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t, r.stick, r.E_diss)
-        rep.impacts.append(imp)
-        rep.P_contact -= complex(r.P_n, r.P_t) * n
-        rep.P_n += r.P_n
-        rep.P_t += r.P_t
-        rep.E_diss += r.E_diss
-        self._n_impacts += 1
-        self._t_last, self._v_last = t, r.rdot
+        self._record_impact(rep, Impact(t, z, v_minus, r.v_plus, r.rdot, r.P_n, r.P_t,
+                                        r.stick, r.E_diss), n)
         self._z, self._v = z, r.v_plus
         self._on_wall = True
         if plastic:
@@ -211,6 +205,13 @@ class FlightSteps:
             d = p.d
             self._t_contact = t + (2.0 * d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)
             self._enter_contact()
+
+    def _record_impact(self, rep: StepReport, imp: Impact, n: complex) -> None:
+        """An impact at the unit normal n: into the step's report and the core's counters
+        (both cores)."""
+        rep.add_impact(imp, n)
+        self._n_impacts += 1
+        self._t_last, self._v_last = imp.t, imp.rdot
 
     def _outward_accel(self, n: complex, v: complex) -> float:
         """A (m/s^2): outward normal acceleration at the wall from contact-free forces."""

@@ -62,6 +62,16 @@ class StepReport:
     """Imbalance reaction torque on the spin (N m), step average P_imb/h: a drivetrain that
     owns the spin inertia integrates J Omega' = T_drive + T_f + T_imb."""
 
+    def add_impact(self, imp: Impact, n: complex) -> None:
+        """Add an impact at the unit contact normal n (inertial): the impact itself, its
+        impulse on the rotor -(P_n + i P_t) n, its normal and friction impulses and its
+        dissipation."""
+        self.impacts.append(imp)
+        self.P_contact -= complex(imp.P_n, imp.P_t) * n
+        self.P_n += imp.P_n
+        self.P_t += imp.P_t
+        self.E_diss += imp.E_diss
+
     def add_contact(self, tal: ContactTally, mc: float, c_r: float) -> None:
         """Add a contact segment's integrals (per unit m c_r; mc = m c_r)."""
         self.P_contact += mc * tal.I_c

@@ -294,10 +294,11 @@ class TouchdownCore(FlightSteps, ContactSteps):
         t0, s = self._t, h
         whole = self._whole_step(h, rep)  # choose: the whole step in one closed form?
         if whole is None:  # else segment by segment, each chosen where the last ended
-            start = self._imb_start()
+            imb = self.imbalance_torque
+            start = self._imb_start() if imb else None
             st = StepContext(cap, self._mode == MODE_SLIDING)
             s = self._segments(h, t0, rep, st)
-            if self.imbalance_torque and not st.imb_whole:
+            if imb and not st.imb_whole:
                 self._imb_close(rep, start, s)
         self._finish(rep, t0, s, h, whole is not _PROVED_FREE)
         return rep

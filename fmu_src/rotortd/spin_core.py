@@ -212,14 +212,8 @@ class SpinCore(TouchdownCore):
             d = r.d_eff
             self._t_contact = t + (2.0 * d * rdot / ((1.0 - d) * A) if 0.0 < d < 1.0
                                    else 0.0)
-        rep.impacts.append(Impact(t, z, v_minus, v_plus, rdot, r.P_n, r.P_t, r.stick,
-                                  r.E_diss))
-        rep.P_contact -= complex(r.P_n, r.P_t) * n
-        rep.P_n += r.P_n
-        rep.P_t += r.P_t
-        rep.E_diss += r.E_diss
-        self._n_impacts += 1
-        self._t_last, self._v_last = t, rdot
+        self._record_impact(rep, Impact(t, z, v_minus, v_plus, rdot, r.P_n, r.P_t, r.stick,
+                                        r.E_diss), n)
         self._z, self._v = z, v_plus
         self._set_spin(W + r.dOmega)
         return plastic
