@@ -70,7 +70,7 @@ class FmuSpec:
 
 
 ROTOR_EQUATIONS = """
-<h2>Equations (MODEL.md &sect;1, outputs for a system model)</h2>
+<h2>Equations (docs/model.md &sect;1, outputs for a system model)</h2>
 <p>Position z = x + i y (inertial frame), spin angle &psi; with &psi;' = &Omega;.
 Free flight while |z| &lt; c<sub>r</sub>:</p>
 <pre>m z'' = a (F_bias &minus; c z' &minus; k z)

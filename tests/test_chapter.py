@@ -1,4 +1,4 @@
-"""Chapter reproduction (MODEL.md §4): BEB, forward rub, period-one impacting cycles.
+"""Chapter reproduction (docs/validation.md §4): BEB, forward rub, period-one impacting cycles.
 
 Everything is computed and checked for properties; nothing is pasted from a run.
 Scaled co-rotating units (positions c_r, velocities c_r Omega, times 1/Omega).

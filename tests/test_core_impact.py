@@ -1,4 +1,4 @@
-"""The reset law (MODEL.md eq. (2)) with the Coulomb stick cap."""
+"""The reset law (docs/model.md §4) with the Coulomb stick cap."""
 
 from __future__ import annotations
 

@@ -79,3 +79,17 @@ def test_bad_input_is_named_and_state_kept(kw: dict, name: str) -> None:
     with pytest.raises(InputError, match=f"^{name} = "):
         core.step(**args)
     assert core.get_state() == before
+
+
+def test_declared_ranges_lie_inside_the_model_domain() -> None:
+    """Every FMU range of a RotorParams field (``limits.LIMITS``) is inside the domain that
+    RotorParams checks: both ends construct (the others at their defaults)."""
+    from dataclasses import fields
+
+    from rotortd.limits import LIMITS
+
+    names = {f.name for f in fields(RotorParams)} & set(LIMITS)
+    assert len(names) >= 9, names
+    for name in sorted(names):
+        for end in (LIMITS[name].lo, LIMITS[name].hi):
+            RotorParams(**{name: end})

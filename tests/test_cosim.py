@@ -120,7 +120,7 @@ def spin_balance(res: dict[str, np.ndarray], step: float, rotor: dict[str, float
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Per step k >= 1: the residual J (Omega_k - Omega_k-1) - h (T_drive,k-1 + T_f,k) of
     the spin's balance [N m s] without the imbalance's reaction torque
-    e_c Im(conj(F_amb + F_ext + F_c) E) (MODEL.md 6, eq. 7; not an output), and a bound on
+    e_c Im(conj(F_amb + F_ext + F_c) E) (docs/model.md §8; not an output), and a bound on
     that torque's impulse [N m s]:
     h e_c (amb_on (m g [levitate] + k c_r + c |v|) + |F_ext| + sqrt(1 + mu^2) F_n), with
     |v| taken as twice the larger of its values at the step's ends (a margin: the

@@ -3,7 +3,7 @@
 T_imb = e_c Im(conj(F_amb + F_ext + F_c) e^{i(psi + phi)}), averaged over a held-Omega step
 with impacts counted as P/h, is checked against references that share no code with the
 core: scipy's DOP853 (rtol 1e-12) integrates the model's equations, written out here from
-MODEL.md 1 and 6, carrying the torque's integrand as an extra component and computing the
+docs/model.md §1 and §8, carrying the torque's integrand as an extra component and computing the
 contact force from its own state:
 
 - free flight (proved clear, or searched): the translational equation (1);

@@ -1,7 +1,8 @@
 """Tests of the independent direct-integration reference ``tests/reference/direct.py``.
 
 All checks are against closed-form facts (steady whirl, free fall, straight-line flight, the
-impact law, the loop-the-loop lift-off angle) or the qualitative outcomes of MODEL.md §4, never
+impact law, the loop-the-loop lift-off angle) or the qualitative outcomes of docs/validation.md §4,
+never
 against the product core. Errors are measured in scaled units: positions in c_r, velocities in
 c_r Omega, times in 1/Omega.
 """
@@ -35,7 +36,7 @@ CHAPTER: dict[str, Any] = {
 
 
 def chapter(**kw: Any) -> dict[str, Any]:
-    """Chapter parameter set (MODEL.md §3) with overrides."""
+    """Chapter parameter set (`rotortd.scaled.CHAPTER`) with overrides."""
     return {**CHAPTER, **kw}
 
 
@@ -225,7 +226,8 @@ def test_max_impacts_caps_work() -> None:
 
 
 def _chatter(t_end: float) -> tuple[DirectResult, float]:
-    """gamma = 0.3 from rest (MODEL.md §1), samples over the last 20/Omega; returns wall time."""
+    """gamma = 0.3 from rest (docs/model.md §1), samples over the last 20/Omega;
+    returns wall time."""
     par = chapter(c=c_for_gamma(0.3))
     te = np.linspace(t_end - 20.0 / OMEGA, t_end, 201)
     t_start = time.perf_counter()

@@ -1,5 +1,6 @@
 """Tests of the independent spin-as-a-state reference (``tests/reference/spin_reference.py``,
-``spin_mp.py``): the SPEC impact law over random impacts (never creates energy, agrees with
+``spin_mp.py``): the impact law of docs/model.md §8 over random impacts (never creates energy,
+agrees with
 mpmath), its stick / slide / slip-reversal outcomes, the DOP853 flight against an mpmath Taylor
 flight, exact conservation scenes, the graze search, the steady whirl helper, and the drop into
 dry whip. Nothing here imports the product core ``rotortd``.
@@ -131,7 +132,7 @@ def test_impact_law_never_creates_energy() -> None:
     # every outcome kind is exercised
     assert c["stick"] > 500 and c["slide"] > 500 and c["reversal"] > 50 and c["d1"] > 2000
     assert c["capped"] > 10, c
-    assert st["worst_spec"] <= 1e-14, st["worst_spec"]  # the SPEC's literal cap recipe too
+    assert st["worst_spec"] <= 1e-14, st["worst_spec"]  # the model's literal cap recipe too
 
 
 def test_impact_cap_is_tight() -> None:
@@ -218,7 +219,7 @@ def test_flight_agrees_with_mp_taylor() -> None:
 
 
 def test_flight_closed_form_bearing_off() -> None:
-    """a = 0, F_ext = 0: z_G on a parabola, psi quadratic (SPEC closed form)."""
+    """a = 0, F_ext = 0: z_G on a parabola, psi quadratic (closed form)."""
     p = {**CHAPTER_G}
     J, T_drive = 0.02, 3.0
     z0, v0, psi0, om0, t = 1e-4 + 2e-4j, 0.002 - 0.001j, 0.3, 100.0, 0.004

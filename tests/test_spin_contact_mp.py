@@ -1,4 +1,4 @@
-"""The spin-as-a-state contact segments (``rotortd.spin_contact.SpinContact``, MODEL.md §6,
+"""The spin-as-a-state contact segments (``rotortd.spin_contact.SpinContact``, docs/model.md §8,
 docs/model.md §8) against the 40-digit Taylor integration ``tests.reference.spin_mp.mp_contact``
 (its own coding of the equations; no shared code).
 

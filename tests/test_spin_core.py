@@ -1,4 +1,4 @@
-"""SpinCore, the rotor with its spin as a state: balances, state, work (MODEL.md §6).
+"""SpinCore, the rotor with its spin as a state: balances, state, work (docs/model.md §8).
 
 The balances are computed here from the core's public state (z, v, psi, Omega), not from
 its internals: T = 1/2 m |z_G'|^2 + 1/2 J Omega^2 with z_G' = v + i Omega e_c E,
@@ -45,7 +45,7 @@ def _run(core: SpinCore, h: float, n: int, **inputs: float) -> list[int]:
 def test_conservation_scene_keeps_momentum_and_energy(d: float) -> None:
     """mu = 0, a = 0, g = 0, F_ext = 0, T_drive = 0: the contact force is normal and passes
     through the bearing centre, so L is conserved through impacts and contact; with d = 1
-    the energy too (MODEL.md §6). Over 1 s, to 1e-12 relative."""
+    the energy too (docs/model.md §8). Over 1 s, to 1e-12 relative."""
     p = RotorParams(mu=0.0, g=0.0, d=d)
     core = SpinCore(p, J_HALF, 0.3e-3 + 0.1e-3j, 0.08 - 0.05j, 0.4, 184.2)
     b0 = _body(core)

@@ -1,7 +1,7 @@
 """Free flight with the spin as a state (rotortd.spin_flight) against 40-digit references.
 
 References (mpmath, 40 digits, here only): the closed form of the drop scene evaluated in
-mpmath, and a Taylor integration of order 30 written in the SPEC's own form (m z'' with
+mpmath, and a Taylor integration of order 30 written in the model's own form (m z'' with
 the e_c (Omega^2 - i Omega') E term, cos/sin recurrences for E), not the z_G form of the
 core's Taylor method. The reference integrator is itself checked against the mp closed form.
 """
@@ -75,7 +75,7 @@ def _horner(coeffs, u):
     return r
 
 class MpTaylor:
-    """40-digit Taylor integration of the SPEC's free-flight ODE, order 30, dense output."""
+    """40-digit Taylor integration of the model's free-flight ODE, order 30, dense output."""
 
     ORDER = 30
 

@@ -32,7 +32,7 @@ def _assert_agrees(fmu: Path, scene: str, h: float, api: str, workdir: Path) -> 
 
 
 def test_scenes_present() -> None:
-    """Eleven scenes covering the behaviours of MODEL.md §4, each with all its files."""
+    """Eleven scenes covering the behaviours of docs/validation.md §4, each with all its files."""
     assert len(SCENES) >= 11
     for name in SCENES:
         for suffix in ("_par.json", "_ref.csv", "_ref.opt", "_impacts.csv", "_sens.json",

@@ -3,7 +3,7 @@
 Used by tests/test_validation.py and docs/scripts/validation.py. The scenes and their
 references live in models/scenes/ (written by tests/reference/make_references.py).
 
-Units of every error: scaled (MODEL.md §5) -- positions in c_r, velocities in c_r Omega,
+Units of every error: scaled (docs/model.md §1) -- positions in c_r, velocities in c_r Omega,
 times in 1/Omega.
 
 **Tolerance rule.** Every compared quantity q (an impact's time, position, velocity before
@@ -18,10 +18,10 @@ amplification a_q: the largest scaled change of q when the initial state is pert
 amplified at most like a start error:
 
 * TOL_UNIT = 1e-13 (about 450 eps): the rounding of the start values and of the closed-form
-  flight (a few eps each, MODEL.md §5);
+  flight (a few eps each, docs/model.md §2);
 * t_q/h: every communication step restarts the exact flight from a float64 state, so each
   step adds about one rounding of the state (the error therefore grows as h shrinks);
-* (1 + |v|)/rdot per impact: the event-location limit of MODEL.md §5, eps c_r/rdot, with the
+* (1 + |v|)/rdot per impact: the event-location limit of docs/model.md §3, eps c_r/rdot, with the
   flight's rounding scaled by the speed |v| (large in dry whip, |v| ~ R Omega);
 * K_ROUND = 4: "a small multiple" -- the largest ratio measured over all 11 scenes, 4 steps
   and both interfaces when the rule was set was 1.3 (docs/validation.md).

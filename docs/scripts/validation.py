@@ -4,7 +4,7 @@
 
 Builds the FMU from the current sources into a temporary directory, runs every scene of
 models/scenes/ through FMPy (CLI and API) at every communication step of
-tests/validation_lib.STEPS, compares impact by impact with the mpmath reference and the
+``STEPS`` (tests/validation_lib.py), compares impact by impact with the mpmath reference and the
 direct integrator, and writes:
 
 * the generated block of docs/validation.md (between the BEGIN/END markers);

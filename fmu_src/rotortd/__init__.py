@@ -3,7 +3,7 @@
 Pure Python on ``math``/``cmath`` (no numpy, no pythonfmu), so it is fast for scalar
 work and safe inside any FMI host. SI units and the inertial frame unless stated.
 The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``TouchdownCore``
-(the spin held over each step) and ``SpinCore`` (the spin as a state, MODEL.md §6).
+(the spin held over each step) and ``SpinCore`` (the spin as a state, docs/model.md §8).
 """
 
 from .contact import RubEquilibrium, WallForces, forward_rub_equilibria

@@ -1,4 +1,4 @@
-"""Sustained contact on the clearance circle: sliding and rolling (MODEL.md eq. (3)).
+"""Sustained contact on the clearance circle: sliding and rolling (docs/model.md §5).
 
 Frame and units: inertial, SI. On the circle z = c_r e^{i theta}; the state is the polar
 angle theta (rad) and the whirl rate theta' (rad/s). Forces are written per unit m c_r

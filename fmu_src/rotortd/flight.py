@@ -1,4 +1,4 @@
-"""Exact free flight of the rotor centre between events (MODEL.md eq. (1)).
+"""Exact free flight of the rotor centre between events (docs/model.md §1).
 
 Frame and units: inertial, SI. ``z`` (m) and ``v = z'`` (m/s) are complex. Over one
 segment the inputs ``Omega`` (rad/s), ``F_ext`` (N) and the bearing state ``a`` are held,

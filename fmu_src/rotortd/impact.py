@@ -1,4 +1,4 @@
-"""Impact reset law with restitution and Coulomb friction (MODEL.md eq. (2)).
+"""Impact reset law with restitution and Coulomb friction (docs/model.md §4).
 
 Frame and units: inertial, SI. At an impact the rotor centre z lies on the clearance
 circle (|z| = c_r), n = z/|z| is the outward normal and i n the tangent. With normal speed

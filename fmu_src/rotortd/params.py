@@ -1,7 +1,7 @@
 """Physical parameters of the rotor–touchdown-bearing model and their scaled form.
 
 Everything here is SI and frame-free (parameters, not states). The scaled set is the
-chapter's non-dimensional form (MODEL.md §2), defined for a spin speed ``Omega != 0``.
+chapter's non-dimensional form (docs/model.md §1), defined for a spin speed ``Omega != 0``.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ def check_range(
 
 @dataclass(frozen=True)
 class ScaledParams:
-    """The chapter's scaled parameter set (MODEL.md §2), dimensionless.
+    """The chapter's scaled parameter set (docs/model.md §1), dimensionless.
 
     gamma = c/(m |Omega|), omega = sqrt(k/m)/|Omega|, rho = e_c/c_r, phi (rad), mu, d,
     R_over_cr = R/c_r. Time is t = Omega*tau, positions are in units of c_r.
@@ -64,9 +64,10 @@ class ScaledParams:
 
 @dataclass(frozen=True)
 class RotorParams:
-    """Rotor and bearing parameters, SI units (MODEL.md §1 and §3), within the model's
-    mathematical domain below. The FMU accepts the narrower physical ranges of
-    ``limits.LIMITS``, all inside this domain (tests/test_limits.py checks it).
+    """Rotor and bearing parameters, SI units (docs/model.md §1; the chapter's set is
+    ``rotortd.scaled.CHAPTER``), within the model's mathematical domain below. The FMU
+    accepts the narrower physical ranges of ``limits.LIMITS``, all inside this domain
+    (tests/test_core_params.py checks it).
 
     m    rotor mass, kg (> 0)
     c    AMB damping, N s/m (>= 0)

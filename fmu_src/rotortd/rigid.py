@@ -1,4 +1,4 @@
-"""The rotor as one rigid body with its spin as a state (MODEL.md §6): the contact point's
+"""The rotor as one rigid body with its spin as a state (docs/model.md §8): the contact point's
 geometry, the Delassus matrix W and the impact law.
 
 Frame and units: inertial, SI. The rotor's geometric centre is z, its mass centre

@@ -1,4 +1,5 @@
-"""The chapter's scaled co-rotating frame (MODEL.md §2) and its example rotor (MODEL.md §3).
+"""The chapter's scaled co-rotating frame (docs/model.md §1) and its example rotor
+(``CHAPTER``).
 
 Frames and units. The core works in SI and the inertial frame: time tau (s), position z (m),
 velocity z' (m/s), spin angle psi (rad). The scaled co-rotating frame, defined for a spin
@@ -34,7 +35,7 @@ TWO_PI_LO = 2.4492935982947064e-16
 """2 pi - TWO_PI_HI (rad): the two-part 2 pi that keeps long angle reductions from drifting."""
 
 CHAPTER = RotorParams()
-"""The chapter's experimental set in SI (MODEL.md §3): m = 50 kg, c = 1400 N s/m,
+"""The chapter's experimental set in SI (`rotortd.scaled.CHAPTER`): m = 50 kg, c = 1400 N s/m,
 k = 9.8e5 N/m, e_c = 0.3 mm, phi = 0.21 rad, c_r = 0.7 mm, R = 0.04 m, mu = 0.15,
 d = 0.95, no gravity (the ``RotorParams`` defaults)."""
 CHAPTER_OMEGA = 184.2

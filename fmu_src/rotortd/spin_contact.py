@@ -1,4 +1,4 @@
-"""Sustained contact with the spin as a state (MODEL.md §6): sliding and rolling.
+"""Sustained contact with the spin as a state (docs/model.md §8): sliding and rolling.
 
 Frame and units: inertial, SI. On the circle z = c_r n, n = e^{i theta}; with
 E = e^{i(psi + phi)}, beta = psi + phi - theta, B = e_c sin(beta), A = R - e_c cos(beta)

@@ -1,4 +1,4 @@
-"""The rotor with its spin as a state (MODEL.md §6): ``SpinCore``.
+"""The rotor with its spin as a state (docs/model.md §8): ``SpinCore``.
 
 Frame and units: inertial, SI. A ``SpinCore`` is a ``TouchdownCore`` whose spin speed Omega
 is a state instead of a held input: translation and spin are solved together as one rigid

@@ -1,4 +1,5 @@
-"""Free flight of a rigid rotor whose spin speed is a state (MODEL.md 6, spin-SPEC "Free flight").
+"""Free flight of a rigid rotor whose spin speed is a state
+(docs/model.md §8, "Segments and their errors").
 
 Frame and units: inertial, SI. State: geometric centre ``z`` (m, complex), ``v = z'`` (m/s),
 spin angle ``psi`` (rad, unwrapped) and ``Omega = psi'`` (rad/s). With E = e^{i(psi + phi)},
@@ -27,7 +28,7 @@ Trajectory
   few eps, relative to c_r in position, to the step's velocity scale c_r w in velocity and
   to max(|Omega|, w) in Omega; over a flight it accumulates with the number of steps k as
   assumed by the search, RHO_INT + k RHO_STEP (8 eps + 2 eps per step). Measured against a
-  40-digit mpmath Taylor integration in the SPEC's own form (tests/test_spin_flight.py):
+  40-digit mpmath Taylor integration in the model's own form (tests/test_spin_flight.py):
   dense output over 0.1 s (14 steps) within 1.2e-15 c_r in position, 1.0e-15 c_r w in
   velocity, 2.3e-16 relative in Omega; the tests require <= 1e-13 c_r and <= 1e-12.
 

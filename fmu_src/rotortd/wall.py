@@ -1,4 +1,4 @@
-"""The wall's forces and what every contact segment shares (MODEL.md eq. (3)).
+"""The wall's forces and what every contact segment shares (docs/model.md §5).
 
 Frame and units: inertial, SI; forces per unit m c_r (1/s^2), as in ``rotortd.contact``'s
 docstring. WallForces: the contact-free forces at the wall under held inputs.

@@ -1,6 +1,7 @@
 """Independent direct-integration reference for the rotor / touchdown-bearing model.
 
-This module integrates the *raw* equations of MODEL.md §1 with :func:`scipy.integrate.solve_ivp`.
+This module integrates the *raw* equations of docs/model.md §1 with
+:func:`scipy.integrate.solve_ivp`.
 It deliberately imports nothing from ``fmu_src`` / ``rotortd``: it is an independent check of the
 exact event-driven core, and also the "baseline a user would otherwise write" in benchmarks, so the
 integration ``method`` and ``rtol`` / ``atol`` are arguments.
@@ -15,7 +16,7 @@ with ``F_bias = i m g`` if ``levitate`` else 0. The term ``i m e_c Omega' exp(i(
 left out because Omega is held constant within a segment. While ``|z| < c_r`` the state
 ``[x, y, vx, vy]`` is integrated directly. Impacts at ``|z| = c_r`` are located with a terminal
 event ``x^2 + y^2 - c_r^2 = 0`` (direction +1) on the dense output, z is projected onto the
-circle, and the velocity is reset with MODEL.md eq. (2) plus the Coulomb stick cap. A tangential
+circle, and the velocity is reset with docs/model.md §4 plus the Coulomb stick cap. A tangential
 touch that the integrator steps over (both step ends inside the disk) is found afterwards from
 each accepted step's dense output, a polynomial: a bound on its curvature clears the steps that
 stay inside, and on the others ``r`` is evaluated at every interior maximum (roots of the
@@ -23,7 +24,7 @@ derivative); an overshoot of more than a few ulp is an impact (see :func:`_misse
 a reset, the first ``~delta/|rdot^+|`` (delta = a few ulp of c_r) is taken with a Taylor step so
 the event cannot re-detect the same impact (see :func:`_restart_free`).
 
-Sustained contact, integrated in ``(theta, theta')`` with MODEL.md eq. (3)::
+Sustained contact, integrated in ``(theta, theta')`` with docs/model.md §5::
 
     N = Re(e^{-i theta} F) + m c_r theta'^2,      m c_r theta'' = Im(e^{-i theta} F) - F_t
 
@@ -204,7 +205,7 @@ def _sign(x: float) -> float:
 
 def impact_reset(par: Par, Omega: float, n: complex, v_minus: complex, plastic: bool = False
                  ) -> ImpactReset:
-    """Apply MODEL.md eq. (2) with the Coulomb stick cap at the wall point with unit normal n.
+    """Apply docs/model.md §4 with the Coulomb stick cap at the wall point with unit normal n.
 
     ``v_minus`` [m/s], ``Omega`` [rad/s]. Newton restitution ``rdot^+ = -d rdot^-`` (``0`` if
     ``plastic``); tangential change ``-mu (1 + d) rdot^- s`` (``-mu rdot^- s`` if plastic),

@@ -2,9 +2,9 @@
 
 This module is deliberately independent of the product code (``fmu_src/rotortd``):
 it imports nothing from it and uses different numerical methods, so that the two
-can be compared (MODEL.md §5, "measure errors against two independent things").
+can be compared (docs/validation.md §1).
 
-Model (SI units, inertial frame, complex position ``z = x + i y``), MODEL.md §1::
+Model (SI units, inertial frame, complex position ``z = x + i y``), docs/model.md §1::
 
     m z'' = a (F_bias - c z' - k z) + m e_c Ω² exp(i(ψ + φ)) + F_ext_total,   ψ' = Ω
 

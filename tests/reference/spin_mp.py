@@ -1,4 +1,4 @@
-"""High-precision (mpmath) checks for the rotor with the spin as a state (spin-SPEC, MODEL §6).
+"""High-precision (mpmath) checks for the rotor with the spin as a state (docs/model.md §8).
 
 Independent of ``fmu_src/rotortd`` and of :mod:`tests.reference.spin_reference` (no shared
 code). SI units, inertial frame, complex positions.
@@ -9,12 +9,12 @@ code). SI units, inertial frame, complex positions.
   rate of the problem (``|Omega|``, ``sqrt(k/m)``, ``c/m``); the truncation term of each step is
   ``~ 4^-order``, far below ``10^-dps``. Returns ``(z, v, psi, Omega)`` at ``t``.
 * :func:`mp_contact`: one sustained-contact segment (sliding with slip sign s, or rolling) from
-  MODEL.md §6, with the impulses int N, int F_t, int F_c and the friction dissipation
+  docs/model.md §8, with the impulses int N, int F_t, int F_c and the friction dissipation
   int mu N |v_rel|, optionally stopped at the first zero of v_rel (slip zero) or N (lift-off):
   Taylor series by automatic differentiation (exponentials, products and the 2x2 / 3x3 solve
   as series recurrences), order dps + 10, steps of at most 1/(8 w); 40 and 50 digits (12 steps
   per radian) agree to 1e-50 (``tests/test_spin_contact_mp.py``).
-* :func:`mp_impact`: the SPEC's impact law (restitution, Coulomb with the slip after the impact,
+* :func:`mp_impact`: the model's impact law (restitution, Coulomb with the slip after the impact,
   stick, energetic cap with its closed forms and the 60-halving bisection) in mpmath.
 
 Free-flight equations::
@@ -104,7 +104,7 @@ def _sgn(x: Num) -> int:
 
 def _law_at(w: tuple[Num, Num, Num], mu: Num, d_eff: Num, rd: Num, s: Num
             ) -> tuple[Num, Num, Num, Num, bool, Num]:
-    """(P_n, P_t, rdot+, v_rel+, stick, dT) at restitution d_eff (SPEC steps 1-4)."""
+    """(P_n, P_t, rdot+, v_rel+, stick, dT) at restitution d_eff (the impact law's steps 1-4)."""
     wnn, wnt, wtt = w
     D = (1 + d_eff) * rd
     det = wnn * wtt - wnt * wnt
@@ -126,8 +126,9 @@ def _law_at(w: tuple[Num, Num, Num], mu: Num, d_eff: Num, rd: Num, s: Num
 def mp_impact(m: float, J: float, e_c: float, R: float, mu: float, d: float, beta: float,
               rdot_minus: float, v_rel_minus: float, n: complex = 1 + 0j, v_minus: complex = 0j,
               Omega_minus: float = 0.0, dps: int = 40, cap: str = "largest") -> dict[str, Any]:
-    """The SPEC impact law in mpmath (``cap`` as in the float reference: "largest" for the
-    largest admissible d_eff in [0, d], "spec" for the SPEC's literal bisection recipe).
+    """The impact law of docs/model.md §8 in mpmath (``cap`` as in the float reference:
+    "largest" for the
+    largest admissible d_eff in [0, d], "spec" for the model's literal bisection recipe).
     Returns a dict with P_n, P_t [N s], v_plus [m/s], Omega_plus [rad/s], stick (bool), d_eff,
     E_diss [J] (= -dT), rdot_plus, v_rel_plus [m/s].
 
@@ -326,7 +327,7 @@ def mp_contact(params: dict[str, Any], J: float, s: int, theta0: float, dtheta0:
                psi0: float, Omega0: float, t: float, a: float = 0.0, F_ext: complex = 0j,
                T_drive: float = 0.0, event: str | None = None, dps: int = 40,
                order: int | None = None, per_rad: int = 8) -> dict[str, Num]:
-    """One contact segment (MODEL.md §6) from t = 0 to t [s], or to the first zero of the
+    """One contact segment (docs/model.md §8) from t = 0 to t [s], or to the first zero of the
     event function (``event``: "slip_zero" for v_rel, sliding only; "lift_off" for N) if
     that comes first; sliding with slip sign s = +-1, rolling with s = 0 (theta' =
     -R Omega/c_r, ``dtheta0`` ignored). Taylor method of order ``order`` (default

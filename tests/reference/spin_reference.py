@@ -1,7 +1,7 @@
-"""Independent event-driven reference for the rotor with the spin as a state (spin-SPEC, MODEL §6).
+"""Independent event-driven reference for the rotor with the spin as a state (docs/model.md §8).
 
 The rotor is one rigid body (translation + spin). This module integrates the raw equations of
-``/work/spin-SPEC.md`` with :func:`scipy.integrate.solve_ivp` (DOP853, tight tolerance, dense
+docs/model.md §8 with :func:`scipy.integrate.solve_ivp` (DOP853, tight tolerance, dense
 output). It imports nothing from ``fmu_src`` / ``rotortd`` (not even the parameters): it is an
 independent check of the core's spin extension. SI units, inertial frame, planar vectors as
 complex numbers ``z = x + i y``.
@@ -36,8 +36,8 @@ has ``N > 0`` and ``|F_t| <= mu N``; else slide with the ``s`` whose sliding sol
 ``sign(v_rel') = s`` and ``N > 0`` (the developing slip), falling back to ``s = sign(F_t)`` of the
 rolling solution; if ``N <= 0`` the rotor lifts off.
 
-Impacts follow the SPEC's law (Newton restitution on ``rdot``, Coulomb friction with the slip
-after the impact, stick when admissible, energetic cap), coded here from the SPEC text in
+Impacts follow the model's law (Newton restitution on ``rdot``, Coulomb friction with the slip
+after the impact, stick when admissible, energetic cap), coded here from the model statement in
 :func:`impact_law`.
 
 Chattering rule (documented choice). An impact with ``rdot^- > 0`` is made *plastic*
@@ -134,7 +134,7 @@ class SpinPar:
         return 1j * self.m * self.g if self.levitate else 0j
 
     def check_well_posed(self) -> None:
-        """Refuse J <= m mu e_c (R + e_c) (the SPEC's sufficient well-posedness bound)."""
+        """Refuse J <= m mu e_c (R + e_c) (the model's sufficient well-posedness bound)."""
         bound = self.m * self.mu * self.e_c * (self.R + self.e_c)
         if not bound < self.J:
             raise ValueError(f"J = {self.J} must exceed m mu e_c (R + e_c) = {bound}")
@@ -152,7 +152,7 @@ def _sign(x: float) -> float:
 
 @dataclass(frozen=True)
 class ImpactOutcome:
-    """Impulses and contact-point velocities of one impact (SPEC impact law).
+    """Impulses and contact-point velocities of one impact (the impact law of docs/model.md §8).
 
     ``P_n`` [N s] inward normal impulse (>= 0), ``P_t`` [N s] tangential impulse (impulse on the
     rotor ``-(P_n + i P_t) n``); ``rdot_plus = -d_eff rdot^-`` and ``v_rel_plus`` [m/s];
@@ -179,7 +179,7 @@ def delassus(m: float, J: float, e_c: float, R: float, beta: float) -> tuple[flo
 
 def _law_at(w: tuple[float, float, float], mu: float, d_eff: float, rd: float, s: float
             ) -> tuple[float, float, float, float, bool, float]:
-    """Steps 1-4 of the SPEC at restitution d_eff: (P_n, P_t, rdot+, v_rel+, stick, dT)."""
+    """Steps 1-4 of the impact law at restitution d_eff: (P_n, P_t, rdot+, v_rel+, stick, dT)."""
     wnn, wnt, wtt = w
     D = (1.0 + d_eff) * rd
     det = wnn * wtt - wnt * wnt
@@ -201,14 +201,14 @@ def _law_at(w: tuple[float, float, float], mu: float, d_eff: float, rd: float, s
 
 def impact_law(m: float, J: float, e_c: float, R: float, mu: float, d: float, beta: float,
                rdot_minus: float, v_rel_minus: float, cap: str = "largest") -> ImpactOutcome:
-    """The SPEC's impact law (Newton + Coulomb with the slip after the impact + energetic cap).
+    """the model's impact law (Newton + Coulomb with the slip after the impact + energetic cap).
 
     ``rdot_minus`` [m/s] >= 0 approach speed, ``v_rel_minus`` [m/s] slip before, ``beta`` [rad]
     = psi + phi - theta; masses in kg, J in kg m^2, lengths in m.
 
-    Cap: if dT > 0 at d, d_eff is set from the SPEC's closed form for the outcome kind found at
+    Cap: if dT > 0 at d, d_eff is set from the model's closed form for the outcome kind found at
     d (stick or slide sigma), clamped to [0, d]; if the kind is the same at that d_eff it is
-    kept (dT(d_eff) = 0 up to rounding). If the kind differs there, the SPEC is ambiguous:
+    kept (dT(d_eff) = 0 up to rounding). If the kind differs there, the model is ambiguous:
     ``cap="largest"`` (default) follows its stated goal, the largest d_eff in [0, d] with
     dT <= 0, by 60 halvings of [d_formula, d] when dT(d_formula) <= 0 and of [0, d_formula]
     otherwise; ``cap="spec"`` follows its literal recipe (keep d_formula when dT(d_formula) <= 0,
@@ -262,7 +262,7 @@ def apply_impulse(m: float, J: float, e_c: float, R: float, n: complex, beta: fl
     ``-(B P_n + A P_t) / J``; the geometric centre's velocity ``z' = z_G' - i Omega e_c E``
     (``E = n e^{i beta}``) therefore changes by ``-(P_n + i P_t) n / m - i e_c E dOmega``, which
     makes ``(d rdot, d v_rel) = -W (P_n, P_t)`` hold for ``rdot = Re(conj(n) z')`` and
-    ``v_rel = R Omega + Im(conj(n) z')``. (The SPEC's line "delta v = -(P_n + i P_t) n / m" is
+    ``v_rel = R Omega + Im(conj(n) z')``. (the model's line "delta v = -(P_n + i P_t) n / m" is
     the change of ``z_G'``; read as the change of ``z'`` it would contradict its own W.)
     """
     B = e_c * math.sin(beta)

@@ -1,7 +1,7 @@
 """Synchronous solutions of the chapter's model: equilibria, rub, impacting cycles.
 
 Frame and units: unless a name says otherwise everything here is in the chapter's
-*scaled co-rotating* frame (MODEL.md §2): time t = Omega tau (dimensionless), position
+*scaled co-rotating* frame (docs/model.md §1): time t = Omega tau (dimensionless), position
 U = z e^{-i psi}/c_r (in units of c_r), velocity U' = dU/dt (in units of c_r Omega). The
 free flight is
 

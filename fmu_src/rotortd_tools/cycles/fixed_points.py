@@ -1,6 +1,6 @@
 """Period-one cycles as fixed points of the core's impact map: Newton, multipliers, ``Cycle``.
 
-Scaled co-rotating (MODEL.md §2), with the SI start (Omega = 184.2 rad/s, psi0 = 0) to run
+Scaled co-rotating (docs/model.md §1), with the SI start (Omega = 184.2 rad/s, psi0 = 0) to run
 the core on a cycle. ``find_period_one_cycle`` is what the sweep's ``cycle`` start calls.
 """
 

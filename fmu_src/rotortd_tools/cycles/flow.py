@@ -1,4 +1,5 @@
-"""The scaled free flow (MODEL.md §2): system matrix, closed-form flight and its gamma derivative.
+"""The scaled free flow (docs/model.md §1): system matrix, closed-form flight and its gamma
+derivative.
 
 Scaled co-rotating frame: t = Omega tau, U = z e^{-i psi}/c_r (in c_r), U' = dU/dt (in c_r
 Omega); w = (U, U') obeys w' = A w + b. Independent of the core (numpy/scipy).

@@ -14,7 +14,7 @@
   plan       what remains to run: independent jobs and continuation chains
   execute    serial or Dask execution, ``run_sweep``
 
-Frame and units: parameters are the chapter's scaled set (MODEL.md §2) plus ``Omega`` in
+Frame and units: parameters are the chapter's scaled set (docs/model.md §1) plus ``Omega`` in
 rad/s; times are scaled, t = Omega tau (one revolution is 2 pi); positions in c_r, speeds
 in c_r Omega, angles in rad, co-rotating (U = z e^{-i psi}/c_r). The names below are the
 package's interface (tests, ``rotortd_tools.cli``, ``sweep_plot``, docs/scripts).

@@ -1,10 +1,11 @@
 """The sweep grammar: parameter names and ranges, axes, settings, starts, and what a point is.
 
-Parameters are the chapter's scaled set (MODEL.md §2: gamma, omega, rho, phi, mu, d,
+Parameters are the chapter's scaled set (docs/model.md §1: gamma, omega, rho, phi, mu, d,
 R_over_cr) plus the spin speed ``Omega`` in rad/s, and the spin-state inputs ``J`` (polar
 inertia about the mass centre, kg m^2: the run uses ``rotortd.SpinCore``, Omega is then only
 the initial spin) and ``T_drive`` (held drive torque, N m; needs J). A point starts from
-the chapter's SI set (MODEL.md §3) at ``Omega`` (default 184.2 rad/s), takes its scaled set
+the chapter's SI set (``rotortd.scaled.CHAPTER``)
+at ``Omega`` (default 184.2 rad/s), takes its scaled set
 and replaces the fields the sweep names (swept or fixed); it is realised in SI with
 m = 50 kg, c_r = 0.7e-3 m, no gravity, bearing on (``point_params``); the ``drop`` start
 adds gravity ``DROP_G`` (``drop_params``). Sweeping ``Omega`` alone therefore keeps the SI

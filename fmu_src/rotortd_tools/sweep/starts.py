@@ -1,6 +1,6 @@
 """Where a run starts: the named starts of a sweep point and continuation from a state.
 
-Scaled co-rotating frame (MODEL.md §2, U = z e^{-i psi}/c_r), the point's SI realisation
+Scaled co-rotating frame (docs/model.md §1, U = z e^{-i psi}/c_r), the point's SI realisation
 for the core:
 
   rest            U = 0, U' = 0
