@@ -52,3 +52,18 @@ def test_the_allowed_list_is_the_documented_one() -> None:
     row = next(line for line in doc.splitlines() if line.startswith("| `rotortd` |"))
     documented = {name for name in CORE_ALLOWED - {"__future__"} if f"`{name}`" in row}
     assert documented == CORE_ALLOWED - {"__future__"}, row
+
+
+def test_loc_counts_logical_lines() -> None:
+    """docs/scripts/loc.py: blanks, comments and docstrings are not logical lines; a
+    multi-line statement counts each of its lines, a string that is not a docstring too."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("loc", SRC.parent / "docs/scripts/loc.py")
+    assert spec and spec.loader
+    loc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(loc)
+    source = ('"""Module\ndocstring."""\n\n# a comment\nimport math\n\n\n'
+              'def f(x: float) -> float:\n    """Doc."""\n    s = """not a\n    docstring"""\n'
+              '    return (math.sin(x)  # trailing comment\n            + len(s))\n')
+    assert loc.count(source) == (13, 6)
