@@ -362,7 +362,7 @@ def test_force_step_pushes_into_bearing_and_releases(systems: Path, engine: str)
 # ---------------------------------------------------------------------------- slow group
 @pytest.mark.slow
 def test_ecos_cli_matches_libcosim(systems: Path) -> None:
-    """The native ecos CLI (LD_PRELOAD of libpython) runs the drop SSP; its CSV carries
+    """The native ecos CLI (no LD_PRELOAD: the FMUs' loader) runs the drop SSP; its CSV carries
     about 6 significant digits, so it agrees with libcosim to that precision."""
     if importlib.util.find_spec("ecospy") is None:  # not imported here: no native code
         pytest.skip("ecospy is not installed")

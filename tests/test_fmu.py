@@ -40,7 +40,7 @@ def run_scenario(fmu: Path, name: str, timeout: float = 120.0, **kwargs: Any) ->
 def test_fmu_validates(fmu_path: Path) -> None:
     import build
 
-    assert build.validate(fmu_path) == []
+    assert build.validate(fmu_path, require_fmutool=True) == []
 
 
 def _model_description(fmu: Path) -> ET.Element:

@@ -18,7 +18,8 @@ Engine differences handled here (see docs/cosimulation.md):
   component's fmi2Discard, and the execution would go on with frozen outputs: refused.
   ecospy goes on after a Discard too, printing the error, and its step returns only the
   time: the runner cannot refuse it.
-- ecos: the bundled binaries need chmod +x; the native CLI needs LD_PRELOAD of libpython.
+- ecos: the bundled binaries need chmod +x; the native CLI needs libtbb on LD_LIBRARY_PATH
+  (the FMUs' own loader finds libpython: no LD_PRELOAD).
   Both ecospy and the CLI need libtbb.so.12: from the environment's ``tbb`` package,
   loaded by :func:`.tbb.load_libtbb` before ecospy is imported, and put on
   LD_LIBRARY_PATH for the CLI.
@@ -31,7 +32,6 @@ import os
 import shutil
 import stat
 import subprocess
-import sysconfig
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -159,17 +159,12 @@ def run_ecospy(ssp: Path, scene: Scene, step: float, stop: float | None = None) 
     return {k: np.asarray(v, float) for k, v in rows.items()}
 
 
-def libpython() -> str:
-    """Path of the shared libpython of this interpreter (for LD_PRELOAD)."""
-    libdir = sysconfig.get_config_var("LIBDIR")
-    name = sysconfig.get_config_var("LDLIBRARY")
-    return str(Path(libdir) / name)
-
-
 def ecos_cli_env() -> dict[str, str]:
-    """The environment for the native ecos CLI: LD_PRELOAD of libpython (for the PythonFMU
-    FMUs) and the environment's libtbb directory first on LD_LIBRARY_PATH."""
-    env = dict(os.environ, LD_PRELOAD=libpython())
+    """The environment for the native ecos CLI: the environment's libtbb directory first on
+    LD_LIBRARY_PATH. No LD_PRELOAD: the FMUs' loader finds a libpython itself
+    (docs/fmu.md "Native hosts")."""
+    env = dict(os.environ)
+    env.pop("LD_PRELOAD", None)
     lib = load_libtbb()
     if lib is not None:
         paths = [str(lib.parent), *filter(None, env.get("LD_LIBRARY_PATH", "").split(":"))]
