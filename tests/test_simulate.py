@@ -112,3 +112,42 @@ def test_start_values_are_typed(fmu_path: Path) -> None:
                    "impact_log": "a b.csv"}
     with pytest.raises(UsageError, match="Omega = nan rad/s is not finite"):
         parse_start_values(["Omega", "nan"], variables)
+
+
+ERROR_AT_THIRD_STEP = """
+import sys
+import fmpy.simulation as sim
+from fmpy.fmi1 import FMICallException
+from rotortd_tools.cli import main
+
+real = sim.simulate_fmu
+
+def failing(*args, step_finished=None, **kwargs):
+    def finished(t, rec):
+        step_finished(t, rec)
+        if t > 2.5e-3:
+            raise FMICallException("fmi2DoStep", int(sys.argv[1]))
+        return True
+    return real(*args, step_finished=finished, **kwargs)
+
+sim.simulate_fmu = failing
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.parametrize(("status", "name"), [(3, "fmi2Error"), (4, "fmi2Fatal")])
+def test_error_status_exits_1_with_the_last_time(fmu_path: Path, tmp_path: Path,
+                                                 status: int, name: str) -> None:
+    """An fmi2Error or fmi2Fatal (FMPy raises; simulated here after the third step, since
+    this project's FMUs never return them) exits 1 naming the status and the last
+    successful time, and the result up to it is written."""
+    proc = subprocess.run(
+        [sys.executable, "-c", ERROR_AT_THIRD_STEP, str(status), "simulate", str(fmu_path),
+         "--stop-time", "0.01", "--output-interval", "1e-3", "--output-file", "e.csv"],
+        capture_output=True, text=True, timeout=300, cwd=str(tmp_path))
+    assert proc.returncode == 1, proc.stderr[-2000:]
+    assert proc.stderr.splitlines() == [
+        f"rotortd simulate: error: the FMU returned {name} from fmi2DoStep at t = 0.003 s "
+        f"(last successful time), short of the stop time 0.01 s: the FMU gave no message; "
+        f"the result up to t = 0.003 s is in e.csv"]
+    assert len((tmp_path / "e.csv").read_text().splitlines()) == 5
