@@ -117,6 +117,8 @@ def prepare(args: argparse.Namespace) -> Run:
     if args.output_interval is not None and not 0.0 < args.output_interval < math.inf:
         raise UsageError(f"--output-interval {args.output_interval!r}: it must be a finite "
                          f"time > 0 s")
+    if args.output_file is not None and not args.output_file.resolve().parent.is_dir():
+        raise UsageError(f"--output-file {args.output_file}: its directory does not exist")
     output = list(args.output_variables) if args.output_variables else None
     for name in output or ():
         if name not in variables:
