@@ -20,9 +20,9 @@ from __future__ import annotations
 from typing import Any
 
 from pythonfmu import DefaultExperiment, Fmi2Slave
-from pythonfmu.enums import Fmi2Status
 
 from .exit_order import register_exit_order
+from .guard import report_error
 from .variables import OUTPUT, PARAMETER, Var, meta, output, register
 
 TIME_EPS = 1e-9  # s: host clocks that add h repeatedly may land just before an event time
@@ -66,8 +66,7 @@ class TouchdownEventsAdapter(Fmi2Slave):
         self._t0 = 0.0
 
     def _refuse(self, name: str) -> Any:
-        return lambda _value: self.log(f"output '{name}' cannot be set by the host",
-                                       Fmi2Status.error)
+        return lambda _value: report_error(self, f"output '{name}' cannot be set by the host")
 
     def _getter(self, name: str) -> Any:
         return lambda: self.schedule(self._t_now)[name]
@@ -85,7 +84,7 @@ class TouchdownEventsAdapter(Fmi2Slave):
             self._t_now = current_time + step_size
             return True
         except Exception as exc:
-            self.log(f"do_step failed: {exc}", Fmi2Status.error)
+            report_error(self, f"do_step failed: {exc}")
             return False
 
     def schedule(self, t: float) -> dict[str, float]:

@@ -5,9 +5,13 @@ No exception may escape into PythonFMU's C wrapper (its fatal path). An adapter 
 logged with ``Fmi2Status.error``, the call returns False (fmi2Discard), and every later
 ``do_step`` is refused with the first failure's message. Standard library and pythonfmu only.
 
-PythonFMU 0.7.0 forwards log messages only when the host turned logging on, so a failure
-also writes one line to stderr (``<instance>: error: <message>``): a user of ``fmpy
-simulate`` sees why the run stopped without extra flags. ``do_step`` after ``terminate``
+An error that leaves the instance usable (a step stopped at the work bound: the next step
+goes on from where it stopped) is reported with ``_error``, which does not fail it.
+
+PythonFMU 0.7.0 forwards log messages only when the host turned logging on, so the first
+error of an instance, of either kind, is also written as one line on stderr
+(``<instance>: error: <message>``): a user of ``fmpy simulate`` sees why the run stopped
+without extra flags. ``do_step`` after ``terminate``
 is refused (FMI allows only fmi2FreeInstance or fmi2Reset then).
 """
 
@@ -27,6 +31,16 @@ class GuardedSlave(Fmi2Slave):
 
     _failure = ""  # non-empty: the model is unusable and do_step refuses
     _terminated = False  # fmi2Terminate was called: do_step refuses
+    _error_shown = False  # the instance's first error went to stderr (report_error)
+
+    def _initialise(self) -> None:
+        """Build the model from the parameters (exitInitializationMode); raise on error."""
+        raise NotImplementedError
+
+    def _step(self, current_time: float, step_size: float) -> bool:
+        """One communication step; False refuses it (reported by the step itself with
+        ``_error``)."""
+        raise NotImplementedError
 
     def terminate(self) -> None:
         self._terminated = True
@@ -49,8 +63,7 @@ class GuardedSlave(Fmi2Slave):
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self._terminated:
-            self.log(f"do_step at t={current_time!r} refused: called after fmi2Terminate",
-                     Fmi2Status.error)
+            self._error(f"do_step at t={current_time!r} refused: called after fmi2Terminate")
             return False
         if self._failure:
             self.log(f"do_step refused, model unusable: {self._failure}", Fmi2Status.error)
@@ -70,12 +83,27 @@ class GuardedSlave(Fmi2Slave):
                        f"output is an error; the value {value!r} was ignored)")
         return refuse
 
+    def _error(self, msg: str) -> None:
+        """Report an error (logged as fmi2Error, the instance's first one also on stderr)
+        without failing the instance: the caller decides what the call returns and whether
+        later steps may go on (a work-bound stop: the next step continues)."""
+        report_error(self, msg)
+
     def _fail(self, msg: str) -> None:
-        first = not self._failure
+        """Report an error and fail the instance: every later do_step is refused with this
+        message until initialisation or a valid state restore clears it."""
         self._failure = msg
-        self.log(msg, Fmi2Status.error)
-        if first:
-            _stderr_line(f"{self.instance_name}: error: {msg}")
+        self._error(msg)
+
+
+def report_error(slave: Fmi2Slave, msg: str) -> None:
+    """Log msg on slave with Fmi2Status.error; the first error of the instance is also
+    written as one line on stderr (``<instance>: error: <msg>``), since PythonFMU forwards
+    log messages only when the host turned logging on. Never raises."""
+    slave.log(msg, Fmi2Status.error)
+    if not getattr(slave, "_error_shown", False):
+        slave._error_shown = True  # type: ignore[attr-defined]
+        _stderr_line(f"{slave.instance_name}: error: {msg}")
 
 
 def _stderr_line(line: str) -> None:
@@ -85,11 +113,3 @@ def _stderr_line(line: str) -> None:
         sys.stderr.flush()
     except Exception:
         pass
-
-    def _initialise(self) -> None:
-        """Build the model from the parameters (exitInitializationMode); raise on error."""
-        raise NotImplementedError
-
-    def _step(self, current_time: float, step_size: float) -> bool:
-        """One communication step; False refuses it (logged by the step itself)."""
-        raise NotImplementedError

@@ -276,14 +276,16 @@ class RotorTouchdownAdapter(GuardedSlave):
                              f"; the model cannot continue")
 
     def _judge_report(self, rep: Any, t_target: float, tol: float) -> bool:
-        """A step the core could not finish (work cap) is refused: the outputs show the
-        state where it stopped and the model time stays there (restore a saved FMU state or
-        continue from core time). A completed step with a non-OK status is a warning."""
+        """A step the core could not finish (work cap) is refused and reported as an error
+        (the instance's first one also on stderr) without failing the instance: the outputs
+        show the state where it stopped and the model time stays there (restore a saved FMU
+        state or continue from core time). A completed step with a non-OK status is a
+        warning."""
         reached = self._core.t
         short = abs(reached - t_target) > tol
-        if rep.status == STATUS_WORK_CAP or short:
-            self.log(f"step incomplete: core status {rep.status} ({rep.message}); model time "
-                     f"stays at t={reached!r} instead of {t_target!r}", Fmi2Status.error)
+        if rep.status == STATUS_WORK_CAP or short:  # an error, but the instance goes on
+            self._error(f"step incomplete: core status {rep.status} ({rep.message}); model "
+                        f"time stays at t={reached!r} instead of {t_target!r}")
             return False
         if rep.status != 0:
             self.log(f"t={reached!r}: core status {rep.status}: {rep.message}",
@@ -347,7 +349,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             # JSON round trip: an independent deep copy, and proof that it serialises.
             return json.loads(json.dumps(state))
         except Exception as exc:
-            self.log(f"getFMUstate failed: {exc}", Fmi2Status.error)
+            self._error(f"getFMUstate failed: {exc}")
             return {"schema": STATE_SCHEMA, "version": STATE_VERSION, "invalid": str(exc)}
 
     def _set_fmu_state(self, state: dict[str, Any]) -> None:

@@ -4,6 +4,7 @@
     rotortd sweep gamma=0.05:0.3:1000 mu=0.15 --starts rest,steady,cycle,large --out S.parquet
     rotortd sweep mu=0.02:0.5:12 J=3.2e-4:1.6:log12 --starts drop --out D.parquet
     rotortd sweep-plot S.parquet -o diagram.png
+    rotortd simulate models/RotorTouchdown.fmu --stop-time 0.1 --start-values g 9.81 ...
 
 RESULT.csv is an FMPy result file (``fmpy simulate ... --output-file RESULT.csv``).
 ``sweep`` and ``sweep-plot`` are described in docs/sweeps.md (code: the package
@@ -213,6 +214,9 @@ def make_parser() -> argparse.ArgumentParser:
     plot.add_argument("--title", default="", help="figure title (default: file name)")
     plot.set_defaults(func=_cmd_plot)
     _add_sweep_parsers(sub)
+    from rotortd_tools.simulate import add_simulate_parser
+
+    add_simulate_parser(sub)
     return parser
 
 
