@@ -1,67 +1,115 @@
 """Bit-exact behaviour fingerprint of the core and the FMU, compared with an earlier commit.
 
-    python docs/scripts/fingerprint.py --base <commit>        # ~40 s on 2 cores (below)
-    python docs/scripts/fingerprint.py --base <commit> --allow-rounding --amplification
+    python docs/scripts/fingerprint.py --base <commit>        # ~25 s on 2 cores (below)
+    python docs/scripts/fingerprint.py --base <commit> --criteria
+    python docs/scripts/fingerprint.py --base <commit> --amplification   # ~90 s
     python docs/scripts/fingerprint.py                          # this tree only: the hashes
+    python docs/scripts/fingerprint.py --check-scenes           # frozen scenes vs this tree
 
-Proof for issue 16 ("behaviour stays exactly as it is"). Every job, a scene run at one
+Proof for issue 16 ("behaviour stays exactly as it is") and the proof tool of issue 23 (one
+physics family: what may move, and by how much). Every job, a scene run at one
 communication step, is recorded to the last bit:
 
-- per step: the core's time, position, velocity and spin angle after the step and the step
-  report (F_contact, F_n, F_n_peak, P_n, T_f, E_diss, mode (the core's where the report has
-  none), status, message, work, work_cap,
-  number of impacts and transitions) and the cumulative counters (n_impacts, E_diss,
-  t_last_impact, v_last_impact, mode); every impact (t, z, v-, v+, rdot, P_n, P_t, stick,
-  E_diss) and transition (t, name) in an event list; all as IEEE doubles, hashed (sha256)
-  per job;
-- at the end: ``core.get_state()`` and the counters in full, floats as ``float.hex``.
+- per step: the core's time, position, velocity, spin angle and spin speed after the step
+  and the step report (F_contact, F_n, F_n_peak, P_n, T_f, T_imb, E_diss, mode (the
+  core's where the report has none), status, message, work, work_cap, number of impacts
+  and transitions) and the cumulative counters (n_impacts, E_diss, t_last_impact,
+  v_last_impact, mode); every impact (t, z, v-, v+, rdot, P_n, P_t, stick, E_diss) and
+  transition (t, name) in an event list; all as IEEE doubles, hashed (sha256) per job;
+- at the end: the core's state JSON (``get_state()``), its reads and ``outputs()`` by
+  name, floats as ``float.hex``;
+- the job's tag: the segment kinds it passed through, with counts (TAGS: P proved-free
+  flight, F searched flight, S sliding, R rolling, L/Q/K the linear, quadratic and locked
+  rub; with the spin as a state C closed-form flight, I integrated flight, s sliding, r
+  rolling), and a summary: impacts, contact time (from the transitions' times), the
+  largest r/c_r at the steps' ends, the steps ending in each mode, nonzero statuses.
 
 The FMU (built from each tree with its own build.py) runs a few scenes through FMPy's
-``FMU2Slave``; per step every output is read, at the end the serialised FMU state.
+``FMU2Slave`` (a spin_* scene with integrate_spin = true); per step every output is read, at
+the end the serialised FMU state. An FMU job takes the tag of the core job of its scene and
+step; its contact time counts the steps that end in contact.
 
 Scenes: (a) every ``models/scenes/*_par.json`` (inputs from ``<Scene>_in.csv``), (b) the five
 benchmark scenes of docs/scripts/benchmarks.py (1 s each; their start values frozen below,
 ``--check-scenes`` compares them with ``benchmarks.make_scenes()``), (c) a bearing-failure
 drop: chapter rotor, g = 9.81, levitated steady whirl at 184.2 rad/s, amb_on 1 -> 0 at
-10 ms, 0.3 s. Steps: ``seg`` (one call per held-input segment: the whole run, or two calls
-around the AMB failure), 0.1 s, 1e-3 s, 1e-4 s and, for (a) and (c), 1e-5 s; a step whose
-schedule equals an earlier one's (0.1 s on a 0.1 s scene) is left out. The scene
-definitions are read once, here, from the current tree, and handed to both recordings.
+10 ms, 0.3 s, (d) the spin as a state (SPIN; ``SpinCore``, the scenes of docs/spin.md and
+docs/scripts/bench_spin.py): the drop into dry whirl (rolling; the pages' "dry whip") from
+the levitated whirl with the bearing failed, J = m R^2/2 and 5 m R^2, 0.3 s; pressed
+sliding (F_ext = -5000j N, the drive torque R mu N balancing the friction), 0.2 s; the
+levitated whirl with the bearing on (integrated flight), 0.1 s; closed-form flight (bearing
+off, g = 0), 0.1 s; the run-down with a braking drive through impacts and a forward rub,
+0.9 s at 1e-3 s (``--check-scenes`` checks their parameters and levitated starts against
+RotorParams and TouchdownCore.on_steady_whirl). Steps: ``seg`` (one call per held-input
+segment: the whole run, or two calls around the AMB failure), 0.1 s, 1e-3 s, 1e-4 s and,
+for (a) and (c), 1e-5 s; (d) at 1e-3 and 1e-4 s; a step whose schedule equals an earlier
+one's (0.1 s on a 0.1 s scene) is left out. The scene definitions are read once, here,
+from the current tree, and handed to both recordings.
 
 ``--base C`` checks out C in a temporary ``git worktree add --detach`` (removed at the end),
 and records it and the current tree (with its uncommitted changes) in two subprocesses run in
 parallel, each with ``PYTHONPATH=<tree>/fmu_src`` (its own code, not the installed editable
 package; each recording checks where ``rotortd`` came from) and ``PYTHONHASHSEED=0``. The
-recording code is this file's, in both trees; it needs only ``TouchdownCore(params, z0, v0,
-psi0, t0)``, ``.step(h, Omega, F_ext=, amb_on=)``, ``.get_state()``, ``RotorParams(**fields)``
-and the StepReport fields, and reads every other attribute (report fields, counters, impact
-fields) with ``getattr`` and a default, so a renamed field shows up as a difference, not a
-crash.
+recording code is this file's, in both trees. It reaches the tree only through the section
+"tree adapter": ``adapt`` builds a scene's core (classes found in ``rotortd`` or any of its
+modules; keyword arguments, else positional), binds its step (``step(h, Omega=, F_ext=,
+amb_on=)``, or ``step(h, F_ext=, amb_on=, T_drive=)`` with the spin as a state), reads the
+state by public name (``core.t``, ``.z``, ... else the ``core.outputs()`` field of that
+name) and the state JSON (``get_state()``, else ``state.to_json()``); report, impact and
+transition fields are read with ``getattr`` and a default, so a renamed field shows up as a
+difference, not a crash; what no fallback fits is the job's error, to be fixed in the
+adapter. The tags come from a hook: ``install_segment_hook`` wraps ``run`` of the segment
+classes (HOOKED, by class name: Flight, Sliding, Rolling, LinearRub, QuadraticRub,
+LockedRub, SpinFlight, SpinContact) so that each logs its kind, read from public attributes
+of the segment (``Flight.search``, ``SpinFlight.closed``, ``SpinContact.rolling``); a held
+step that runs no segment from flight is TouchdownCore's proved-free whole step. No private
+attribute of the core is read. Without any of those classes (a refactored tree) the tags
+fall back to the modes the steps passed through (f, d, o). The tag that is judged is the
+base's.
 
-The table: per job whether it is identical; else the first differing quantity (in time
-order: step row, impact or transition, then the final counters and state), the largest
-difference in scaled units, and whether impact counts and modes are equal at every step.
-Scaled units: positions in c_r, velocities in c_r |Omega|, times in 1/|Omega|, angles in
-rad; forces (m c_r Omega^2), impulses (m c_r |Omega|), torques (R m c_r Omega^2) and
-energies (m (c_r Omega)^2) against the larger of that unit and their own size, since a
-step-averaged P/h at 1e-5 s or the cumulative E_diss is many units large and rounds
-relative to it; other final-state values relative; ``inf`` where a value is missing,
-non-finite or not a number on one side (e.g. the sliding step memo ``H``). Exit 0 iff all
-jobs are identical; with ``--allow-rounding`` iff every difference is <= 1e-13 scaled with
-equal counts, modes and statuses (work counters may differ). An FMU output the head adds
-(T_imb) is reported as "adds ..." and the job compared on the base's columns, the head's
-saved state without it; a removed output is a difference. The saved state's schema
-bookkeeping (versions; J and the adapter's spin when null) is not compared.
+Final states are compared leaf by leaf through STATE_NAMES (the core's state; the FMU's
+below its "core" key, FMU_STATE_NAMES): a map from the base's names to the head's, today
+each name to itself. A new state layout (per-component records, a version bump) is declared
+there, and only there (its docstring shows how); then it is not a difference. Leaves only
+the head has are listed as added, not differences; schema bookkeeping and caches map to
+None (not compared).
 
-``--amplification`` measures, per scene on the current tree at 1e-3 s, how much a 1e-12
-scaled perturbation of the initial state (+-x, +-y in c_r, +-vx, +-vy in c_r |Omega|) grows:
-the largest scaled state difference over the run divided by 1e-12. Only on scenes with an
-amplification <= 10 can a rounding-only change be judged by its size.
+The table: per job whether it is identical; the largest difference in scaled units; the
+base's impacts, modes at the steps' ends (free/sliding/rolling) and nonzero statuses
+("base->head" where they differ); the amplification; the base's tag; the issue-23 criterion
+that applies and whether it holds; for a differing job, on a second line, the first
+differing quantity (in time order: step row, impact or transition, then the final counters
+and state) and whether impact counts, modes and statuses are equal at every step. The
+criteria (``Verdict.judge``): a job carried only by closed forms (CLOSED_FORM: proved-free
+flight, closed-form rolling, the rubs) must be bit-identical; a job whose amplification is
+<= AMP_LOW (10) must be within rounding (<= 1e-13 scaled, equal counts, modes and
+statuses); any other job's impact rate, contact fraction and largest r within STATS_TOL
+(1 %). Scaled units: positions in c_r, velocities in c_r |Omega|, times in 1/|Omega|,
+rates in |Omega|, angles in rad; forces (m c_r Omega^2), impulses (m c_r |Omega|), torques
+(R m c_r Omega^2) and energies (m (c_r Omega)^2) against the larger of that unit and their
+own size, since a step-averaged P/h at 1e-5 s or the cumulative E_diss is many units large
+and rounds relative to it; other final-state values relative; ``inf`` where a value is
+missing, non-finite or not a number on one side. Omega is that of the first segment (the
+initial spin with the spin as a state). Exit 0 iff all jobs are identical; with
+``--allow-rounding`` iff every difference is <= 1e-13 scaled with equal counts, modes and
+statuses (work counters may differ); with ``--criteria`` iff every job meets its criterion.
+An FMU output the head adds (T_imb) is reported as "adds ..." and the job compared on the
+base's columns.
 
-Run time (2 cores, base and head in parallel): 35-45 s for the default set, measured while
-other sessions kept the load average near 14; per tree ~28 s CPU for the core recordings,
-~4 s for the FMU runs and ~1.5 s for its build; ``--amplification`` adds ~5-10 s, ``--no-fmu``
-saves the FMU part. The temporary files (~55 MB per tree) are removed unless ``--keep``.
+Amplification (``amplification_job``): per core job, at its own steps, on the base tree,
+the largest scaled state difference at the steps' ends (z in c_r, v in c_r |Omega|, the
+spin in |Omega|) over the run, divided by 1e-12, for a 1e-12 scaled perturbation of the
+start (+-x, +-y, +-vx, +-vy and, with the spin as a state, +-Omega0); "*" when a perturbed
+run's impact count differs. It costs 8 to 10 runs of the job, so it is measured only for
+the jobs that differ (and the core jobs of differing FMU jobs), in two children; all
+identical: nothing to measure. ``--amplification`` measures every core job (~65 s more);
+``--no-amplification`` none (the rounding and statistics criteria then print "?").
+
+Run time (2 cores, base and head in parallel, load average below 1): ~25 s for the default
+set (of which the spin scenes ~4-7 s CPU per tree for the core jobs and ~2 s for their FMU
+jobs), ~85 s with ``--amplification``; per tree ~15 s CPU for the core recordings, ~3-6 s
+for the FMU runs and ~1.5 s for its build; ``--no-fmu`` saves the FMU part. The temporary
+files (~60 MB per tree) are removed unless ``--keep``.
 """
 
 from __future__ import annotations
@@ -1547,11 +1595,17 @@ def share_core_tags(verdicts: list[Verdict], base: dict[str, Any]) -> None:
 
 def measure_amp(tree: Path, specs: list[Spec], jobs: list[tuple[str, str, str]],
                 tmp: Path) -> dict[str, Any]:
-    """The amplification of ``jobs`` on ``tree``, in a child on the tree's rotortd."""
-    work = tmp / "amp"
-    work.mkdir(exist_ok=True)
-    return run_child(tree, {"mode": "amp", "specs": specs, "out": str(work),
-                            "jobs": [list(j) for j in jobs]}, work)
+    """The amplification of ``jobs`` on ``tree``, in two children on the tree's rotortd
+    (every other job each, in parallel)."""
+    def child(i: int) -> dict[str, Any]:
+        work = tmp / f"amp{i}"
+        work.mkdir(exist_ok=True)
+        return run_child(tree, {"mode": "amp", "specs": specs, "out": str(work),
+                                "jobs": [list(j) for j in jobs[i::2]]}, work)
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        parts = list(pool.map(child, range(2 if len(jobs) > 1 else 1)))
+    return {k: x for part in parts for k, x in part.items()}
 
 
 def print_amps(amps: dict[str, Any]) -> None:
@@ -1563,12 +1617,14 @@ def print_cpu(res: dict[str, Any], by_name: dict[str, Spec]) -> None:
     """CPU seconds of the recordings per tree: core jobs (of them the spin scenes'), FMU."""
     for tree, r in res.items():
         jobs = {k: x for k, x in r.items() if not k.startswith("_") and "seconds" in x}
-        core = [x["seconds"] for k, x in jobs.items() if k.startswith("core__")]
-        spin = [x["seconds"] for k, x in jobs.items()
-                if k.startswith("core__") and is_spin(by_name[k.split("__")[1]])]
-        fmu = [x["seconds"] for k, x in jobs.items() if k.startswith("fmu__")]
-        print(f"{tree}: core jobs {sum(core):.1f} s (spin scenes {sum(spin):.1f} s), "
-              f"FMU jobs {sum(fmu):.1f} s")
+
+        def cpu(kind: str, spin_only: bool, jobs: dict[str, Any] = jobs) -> float:
+            return sum(x["seconds"] for k, x in jobs.items() if k.startswith(f"{kind}__")
+                       and (not spin_only or is_spin(by_name[k.split("__")[1]])))
+
+        print(f"{tree}: core jobs {cpu('core', False):.1f} s (spin scenes "
+              f"{cpu('core', True):.1f} s), FMU jobs {cpu('fmu', False):.1f} s (spin scenes "
+              f"{cpu('fmu', True):.1f} s), wall time per job")
 
 
 def summarise(verdicts: list[Verdict], args: argparse.Namespace, secs: float) -> int:
