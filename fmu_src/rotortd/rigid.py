@@ -23,6 +23,7 @@ energy, the restitution is lowered to the largest value that does not.
 
 from __future__ import annotations
 
+import cmath
 import math
 from dataclasses import dataclass
 
@@ -146,3 +147,31 @@ def spin_impact(w: Delassus, mu: float, d: float, rdot: float, vrel: float) -> S
             dT = _gain(Pn, Pt, rdot, d_eff, vrel, vp)
     return SpinReset(Pn, Pt, -d_eff * rdot, vp, -(w.B * Pn + w.A * Pt) / w.J,
                      stick, d_eff, -dT)
+
+
+@dataclass(frozen=True, slots=True)
+class RigidRotor:
+    """The rotor as one rigid body: mass m (kg), polar inertia J (kg m^2) about the mass
+    centre (``math.inf``: the spin is held, an input), eccentricity e_c (m) at the phase phi
+    (rad) from the spin angle, radius R (m)."""
+
+    m: float
+    J: float
+    e_c: float
+    phi: float
+    R: float
+
+    @classmethod
+    def held(cls, m: float, e_c: float, phi: float, R: float) -> RigidRotor:
+        """The rotor whose spin is held (J = inf)."""
+        return cls(m, math.inf, e_c, phi, R)
+
+    def delassus(self, n: complex, psi: float) -> Delassus:
+        """The rotor's W (1/kg) at normal n with the spin angle psi (rad)."""
+        return Delassus.at(self.m, self.J, self.e_c, self.R, psi + self.phi - cmath.phase(n))
+
+    def velocity_after(self, v: complex, n: complex, psi: float, r: SpinReset) -> complex:
+        """The centre's velocity (m/s) after the impulse -(P_n + i P_t) n of ``r`` at the
+        contact: the translation's change and the mass centre's turn about the centre."""
+        iE = 1j * self.e_c * cmath.exp(1j * (psi + self.phi))
+        return v - complex(r.P_n, r.P_t) * n / self.m - r.dOmega * iE

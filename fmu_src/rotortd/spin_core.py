@@ -24,9 +24,11 @@ import cmath
 import math
 from dataclasses import replace
 
+from .bearing import FixedRigidBearing
 from .events import WORK_MAX
 from .flight_step import starts_contact
 from .impact import Impact
+from .pair import ContactPair
 from .params import InputError, RotorParams, check_finite, check_range
 from .report import (
     MODE_FREE,
@@ -35,7 +37,7 @@ from .report import (
     StepContext,
     StepReport,
 )
-from .rigid import Delassus, check_well_posed, spin_impact
+from .rigid import RigidRotor, check_well_posed
 from .simulator import TouchdownCore
 from .spin_contact import (
     ContactForces,
@@ -57,6 +59,8 @@ class SpinCore(TouchdownCore):
     Raises CrossParameterError when J is too small for the contact to be well posed."""
 
     SPIN_STATE = True
+    _pair: ContactPair | None = None  # the contact pair, built for _pair_of (params, J)
+    _pair_of: tuple[RotorParams, float] | None = None
 
     def __init__(self, params: RotorParams, J: float, z0: complex = 0j, v0: complex = 0j,
                  psi0: float = 0.0, Omega0: float = 0.0, t0: float = 0.0) -> None:
@@ -82,6 +86,19 @@ class SpinCore(TouchdownCore):
     def Omega(self) -> float:
         """Spin speed (rad/s), a state."""
         return self._inputs[0]
+
+    @property
+    def contact_pair(self) -> ContactPair:
+        """The rotor (``rigid.RigidRotor`` with this J) and the bearing it touches (the
+        chapter's ``bearing.FixedRigidBearing``): gap, normal, speeds, W, impact law."""
+        p, J = self._p, self._J
+        key = self._pair_of
+        if key is None or key[0] is not p or key[1] != J:
+            self._pair = ContactPair(RigidRotor(p.m, J, p.e_c, p.phi, p.R),
+                                     FixedRigidBearing(c_r=p.c_r))
+            self._pair_of = (p, J)
+        assert self._pair is not None
+        return self._pair
 
     def set_params(self, params: RotorParams) -> None:
         """Change parameters between steps (tunables); the spin is kept."""
@@ -180,40 +197,39 @@ class SpinCore(TouchdownCore):
         when it touched and contact was refused (no positive normal force): the flight
         goes on. ``sticky``: the flight touched again at once at the same time, so the
         normal force is zero to its rounding band; contact is taken with that slack."""
-        p = self._p
-        z = self._z * (p.c_r / abs(self._z))
-        n = z / p.c_r
-        w = n.conjugate() * self._v
-        if w.real > 0.0:
-            if self._spin_impact(t, z, n, w.real, w.imag, held, rep):
+        pair = self.contact_pair
+        z, n = pair.on_circle(self._z)
+        rdot, vrel = pair.velocities(n, self._v, self._inputs[0])
+        if rdot > 0.0:
+            if self._spin_impact(t, z, n, rdot, vrel, held, rep):
                 self._enter_spin_contact(held, st, False)
             return True
         self._z = z
         return self._enter_spin_contact(held, st, sticky)
 
-    def _spin_impact(self, t: float, z: complex, n: complex, rdot: float, vt: float,
+    def _spin_impact(self, t: float, z: complex, n: complex, rdot: float, vrel: float,
                      held: HeldInputs, rep: StepReport) -> bool:
-        """Apply the impact law at z (on the circle) to normal speed rdot > 0 and tangential
-        speed vt (m/s); True when the low-speed rule makes it plastic (contact starts)."""
-        p, W = self._p, self._inputs[0]
-        beta = self._psi + p.phi - cmath.phase(n)
-        dl = Delassus.at(p.m, self._J, p.e_c, p.R, beta)
-        vrel = p.R * W + vt
-        r = spin_impact(dl, p.mu, p.d, rdot, vrel)
+        """Apply the impact law of the contact pair at z (on the circle) to the separation
+        speed rdot > 0 and the slip vrel (m/s); True when the low-speed rule makes it
+        plastic (contact starts)."""
+        p, W, pair = self._p, self._inputs[0], self.contact_pair
+        dl = pair.delassus(n, self._psi)
+        r = pair.impact(dl, p.mu, p.d, rdot, vrel)
         v_minus = self._v
-        iE = 1j * p.e_c * cmath.exp(1j * (self._psi + p.phi))
-        v_plus = v_minus - complex(r.P_n, r.P_t) * n / p.m - r.dOmega * iE
+        v_plus = pair.rotor.velocity_after(v_minus, n, self._psi, r)
         A = self._outward_accel_spin(z, v_plus, W + r.dOmega, held)
+        vt = (n.conjugate() * (v_minus - pair.bearing.velocity())).imag  # relative, along i n
         plastic = starts_contact(A, r.d_eff * rdot, r.d_eff, p.c_r,
                                  lambda: max(abs(W), abs(vt) / p.c_r, math.sqrt(A / p.c_r)))
         if plastic:
-            r = spin_impact(dl, p.mu, 0.0, rdot, vrel)
-            v_plus = v_minus - complex(r.P_n, r.P_t) * n / p.m - r.dOmega * iE
+            r = pair.impact(dl, p.mu, 0.0, rdot, vrel)
+            v_plus = pair.rotor.velocity_after(v_minus, n, self._psi, r)
             d = r.d_eff
             self._t_contact = t + (2.0 * d * rdot / ((1.0 - d) * A) if 0.0 < d < 1.0
                                    else 0.0)
         self._record_impact(rep, Impact(t, z, v_minus, v_plus, rdot, r.P_n, r.P_t, r.stick,
                                         r.E_diss), n)
+        pair.apply(r, n)
         self._z, self._v = z, v_plus
         self._set_spin(W + r.dOmega)
         return plastic
