@@ -39,7 +39,10 @@ md = read_model_description(fmu)
 vr = {v.name: v.valueReference for v in md.modelVariables}
 unzipped = extract(fmu)
 ident = md.coSimulation.modelIdentifier
-so = str(Path(unzipped) / "binaries" / "linux64" / (ident + ".so"))
+binaries = Path(unzipped) / "binaries" / "linux64"
+# PythonFMU's binary: beside the project's loader (build.py), or alone without a compiler
+so = str(next(p for p in (binaries / (ident + "_pythonfmu.so"), binaries / (ident + ".so"))
+              if p.exists()))
 slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=ident,
                   instanceName="rotor")
 slave.instantiate(loggingOn=True)

@@ -27,6 +27,10 @@ double-linked list". The heap layout at exit decides that, so the abort is rare 
 machine-dependent (issue 18 saw 3 of about 330 runs; 0 of 2300 runs on the machine where the
 cause was found), while valgrind reports the invalid access on every run.
 
+With the project's loader (``fmu_src/native/fmu_loader.c``) PythonFMU's binary is
+``binaries/linux64/<id>_pythonfmu.so`` beside it; every ``*.so`` there is tried, and only the
+one that exports ``finalizePythonInterpreter`` is registered.
+
 This module avoids the path from our side. For the loaded binary of this FMU, it registers
 that binary's exported ``finalizePythonInterpreter`` as an exit handler with ``__cxa_atexit``.
 The registration happens at instantiation, after the binary's static constructors, and exit
