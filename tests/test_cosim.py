@@ -6,8 +6,10 @@ The scenes couple the drivetrain to the bearing with the spin as a state of the 
 subprocess (``python -m rotortd_cosim.run``): PythonFMU FMUs share the host's interpreter and
 can crash it at exit. Quick group: FMPy's SSP master, libcosimpy and ecospy on the three
 scenes, the passive-drive equality with the bearing run alone on each, the in-process master
-against ecospy; slow group: the native ecos CLI, the first-order coupling error with the PI
-drive on each engine, the exact spin balance with e_c = 0, the run-down's lift-off step.
+against ecospy, the scene checks (an unknown scene or an SSP of another scene refused with a
+message, the scene's parameters applied, no log output); slow group: the native ecos CLI,
+the first-order coupling error with the PI drive on each engine, the exact spin balance
+with e_c = 0, the run-down's lift-off step.
 ecospy and the CLI need libtbb.so.12, from the tbb package of the test extra
 (rotortd_cosim.tbb loads it in the engine's process).
 """
@@ -305,6 +307,92 @@ def test_constant_torque_coupling_equals_bearing_alone(systems: Path, engine: st
         assert np.max(np.abs(alone[col] - res[col])) <= 1e-10 * scale, col
     assert res["RotorTouchdown.mode"][-1] == rotortd.MODE_ROLLING  # through the dry whip
     assert res["RotorTouchdown.n_impacts"][-1] > 100
+
+
+# ---------------------------------------------------------------------------- scene checks
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", *args], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT, env=_env())
+
+
+def test_unknown_scene_is_refused_with_the_known_ones(tmp_path: Path) -> None:
+    """An unknown scene: exit 2 and one message listing every known scene, no traceback,
+    nothing written (the runner, the bearing-alone runner and the SSP writer)."""
+    out = tmp_path / "x.npz"
+    for args in (("rotortd_cosim.run", "ecospy", "dorp", "drop.ssp", str(out)),
+                 ("rotortd_cosim.alone", "dorp", "a.fmu", "r.npz", str(out), "--step", "1e-4"),
+                 ("rotortd_cosim.ssp", "dorp", "--out", str(tmp_path))):
+        proc = _cli(*args)
+        assert proc.returncode == 2, (args, proc.stdout, proc.stderr)
+        assert "'dorp'" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+        assert all(name in proc.stderr for name in ALL_SCENES), proc.stderr
+    assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("engine", [*ENGINES, "ecos"])
+def test_ssp_of_another_scene_is_refused(systems: Path, engine: str, tmp_path: Path) -> None:
+    """drop_torque from drop.ssp (its parameter set is the drop scene's, which libcosim and
+    ecos would apply, or none): exit 2 before anything runs, with a message naming the
+    scene, what differs and the command that writes the scene's SSP."""
+    out = tmp_path / "x.npz"
+    proc = _cli("rotortd_cosim.run", engine, "drop_torque", str(systems / "drop.ssp"),
+                str(out))
+    assert proc.returncode == 2 and "DONE" not in proc.stdout, proc.stdout + proc.stderr
+    msg = proc.stderr
+    assert "does not carry the parameters of scene 'drop_torque'" in msg, msg
+    assert "T_motor_in" in msg and "python -m rotortd_cosim.ssp drop_torque" in msg, msg
+    assert not out.exists()
+
+
+def _rewrite_ssd(src: Path, dst: Path, old: str, new: str) -> Path:
+    import zipfile
+
+    with zipfile.ZipFile(src) as zf:
+        text = zf.read("SystemStructure.ssd").decode()
+    assert old in text
+    with zipfile.ZipFile(dst, "w") as zf:
+        zf.writestr("SystemStructure.ssd", text.replace(old, new, 1))
+    return dst
+
+
+def test_ssp_parameter_check(systems: Path, tmp_path: Path) -> None:
+    """rotortd_cosim.engines.ssp_mismatches: every scene's own SSP carries exactly its
+    parameters; one changed value, a renamed set and another scene's SSP are each found."""
+    from rotortd_cosim.engines import SceneError, check_ssp, ssp_mismatches
+
+    for name, scene in ALL_SCENES.items():
+        assert ssp_mismatches(systems / f"{name}.ssp", scene) == [], name
+    drop = systems / "drop.ssp"
+    kp = _rewrite_ssd(drop, tmp_path / "kp.ssp", '<ssv:Parameter name="Kp"><ssv:Real value="0.2"/>',
+                      '<ssv:Parameter name="Kp"><ssv:Real value="0.25"/>')
+    assert ssp_mismatches(kp, DROP) == ["Drivetrain differs in Kp"]
+    named = _rewrite_ssd(drop, tmp_path / "named.ssp", 'ParameterSet version="1.0" name="drop"',
+                         'ParameterSet version="1.0" name="other"')
+    assert ssp_mismatches(named, DROP) == ["RotorTouchdown's parameter set is 'other'"]
+    assert any("Drivetrain differs in" in m for m in ssp_mismatches(drop, DROP_TORQUE))
+    with pytest.raises(SceneError, match="no such SSP file"):
+        check_ssp(tmp_path / "missing.ssp", DROP)
+
+
+@pytest.mark.parametrize("engine", [*ENGINES, "ecos"])
+def test_engines_apply_the_scene_parameters_quietly(systems: Path, engine: str) -> None:
+    """drop_torque for 2 ms on each engine: the drivetrain's torque is the scene's
+    T_motor_in = 2 N m (default 0), and the bearing integrates its spin with J = 0.04
+    kg m^2 (integrate_spin; held at 184.2 rad/s by default): dOmega/dt = (T_drive +
+    T_imb)/J, 43.5 rad/s^2 measured (the imbalance's reaction takes 0.26 N m), where 2 N m
+    alone would give 50. The run prints only its DONE line (libcosim's default log is 90-odd
+    debug lines)."""
+    h = DROP_TORQUE.step
+    out = systems / f"quiet_{engine}.npz"
+    proc = _cli("rotortd_cosim.run", engine, "drop_torque",
+                str(systems / "drop_torque.ssp"), str(out), "--stop", "0.002")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert proc.stdout.startswith("DONE") and len(proc.stdout.splitlines()) == 1, proc.stdout
+    assert proc.stderr == "", proc.stderr
+    res = dict(np.load(out))
+    assert np.all(res["Drivetrain.T_drive"] == 2.0)
+    rate = np.diff(res[OMEGA]) / h
+    assert np.all((rate > 40.0) & (rate < 47.0)), rate
 
 
 # ---------------------------------------------------------------------------- scene 2: rundown

@@ -11,7 +11,10 @@ k - 1 into step k; the first step gets the components' initial outputs, or 0 on 
 master, whose connectors start at 0). :func:`run_alone` steps the FMU with them on FMPy's
 ``FMU2Slave``. Run it in a subprocess (PythonFMU shares the host's interpreter):
 
-    python -m rotortd_cosim.alone SCENE FMU RESULT.npz OUT.npz --step H [--fmpy]
+    python -m rotortd_cosim.alone SCENE FMU RESULT.npz OUT.npz --step H [--fmpy | --ns-clock]
+
+RESULT.npz is a coupled run of the scene (``python -m rotortd_cosim.run``); an unknown
+scene is refused with a message listing the known ones (exit code 2).
 
 Units: SI (s, rad/s, N, N m).
 """
@@ -126,7 +129,7 @@ def _clock(k: int, step: float, ns_clock: bool) -> tuple[float, float]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scene")
+    parser.add_argument("scene", choices=list(ALL_SCENES))
     parser.add_argument("fmu", type=Path)
     parser.add_argument("result", type=Path, help="a coupled run's .npz (rotortd_cosim.run)")
     parser.add_argument("out", type=Path)
@@ -140,6 +143,7 @@ def main(argv: list[str] | None = None) -> int:
     scene = ALL_SCENES[args.scene]
     res: Any = dict(np.load(args.result))
     inputs = jacobi_inputs(res, scene, args.fmpy)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     np.savez(args.out, **run_alone(args.fmu, scene, args.step, inputs,
                                    set_before_init=not args.fmpy,
                                    ns_clock=args.ns_clock))

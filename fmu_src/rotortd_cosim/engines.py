@@ -23,6 +23,12 @@ Engine differences handled here (see docs/cosimulation.md):
   Both ecospy and the CLI need libtbb.so.12: from the environment's ``tbb`` package,
   loaded by :func:`.tbb.load_libtbb` before ecospy is imported, and put on
   LD_LIBRARY_PATH for the CLI.
+- libcosim applies the first parameter set of each component of the SSP, ecos the set
+  named after the scene; neither says so when the SSP holds other values or none.
+  :func:`run` therefore refuses an SSP that does not carry exactly the scene's parameters
+  (:func:`check_ssp`), on every engine, with a :class:`SceneError`.
+- Quiet unless asked: libcosim logs 90-odd debug lines per run at its default level; the
+  runners set it to warnings (ecos likewise) unless ``verbose``.
 """
 
 from __future__ import annotations
@@ -39,10 +45,77 @@ from typing import Any
 import numpy as np
 
 from .scenes import ALL_SCENES, RECORDED, Scene
+from .ssp import parameter_sets
 from .tbb import load_libtbb
 
 Result = dict[str, np.ndarray]
 COLUMNS = [f"{c}.{v}" for c, v in RECORDED]
+
+
+class SceneError(ValueError):
+    """An unknown scene, or an SSP that does not carry the scene's parameters."""
+
+
+def scene_named(name: str) -> Scene:
+    """The scene called ``name``; SceneError listing the known scenes otherwise."""
+    if name not in ALL_SCENES:
+        raise SceneError(f"unknown scene {name!r}; the scenes are "
+                         f"{', '.join(ALL_SCENES)}")
+    return ALL_SCENES[name]
+
+
+def _same_value(kind: str, text: str, value: Any) -> bool:
+    """Whether an SSV value (element name, value text) is the scene's start value."""
+    try:
+        if kind == "Boolean":
+            return text in ("true", "false") and (text == "true") == bool(value)
+        if kind == "Integer":
+            return int(text) == int(value)
+        if kind == "Real":
+            return float(text) == float(value)
+    except ValueError:
+        return False
+    return text == str(value)
+
+
+def ssp_mismatches(ssp: Path, scene: Scene) -> list[str]:
+    """What keeps the engines from applying the scene's parameters from ``ssp``: per
+    component, the first parameter set (libcosim applies it) must be named after the scene
+    (ecos applies that name) and hold exactly the scene's values; a component without
+    values must have no set. Empty when the SSP is the scene's."""
+    sets = parameter_sets(ssp)
+    problems = []
+    for comp, values in scene.components().items():
+        have = sets.get(comp, [])
+        if not values:
+            if have:
+                problems.append(f"{comp} has parameter set {have[0][0]!r}, the scene none")
+            continue
+        if not have:
+            problems.append(f"{comp} has no parameter set")
+            continue
+        name, params = have[0]
+        if name != scene.name:
+            problems.append(f"{comp}'s parameter set is {name!r}")
+        differ = sorted(n for n in {*params, *values} if n not in params or n not in values
+                        or not _same_value(*params[n], values[n]))
+        if differ:
+            problems.append(f"{comp} differs in {', '.join(differ)}")
+    return problems
+
+
+def check_ssp(ssp: Path, scene: Scene) -> None:
+    """SceneError unless ``ssp`` exists and carries exactly the scene's parameters."""
+    if not ssp.is_file():
+        raise SceneError(f"{ssp}: no such SSP file (python -m rotortd_cosim.ssp "
+                         f"{scene.name} writes models/systems/{scene.name}.ssp)")
+    problems = ssp_mismatches(ssp, scene)
+    if problems:
+        raise SceneError(
+            f"{ssp} does not carry the parameters of scene {scene.name!r} "
+            f"({'; '.join(problems)}), and libcosim and ecos take them from the SSP: "
+            f"write the scene's own with python -m rotortd_cosim.ssp {scene.name} "
+            f"(models/systems/{scene.name}.ssp)")
 
 
 def _steps(scene: Scene, step: float, stop: float | None) -> tuple[int, float]:
@@ -64,8 +137,9 @@ def fmpy_parameter_set(scene: Scene) -> Any:
     return pset
 
 
-def run_fmpy_ssp(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
-    """FMPy's fixed-step Jacobi SSP master."""
+def run_fmpy_ssp(ssp: Path, scene: Scene, step: float, stop: float | None = None,
+                 verbose: bool = False) -> Result:
+    """FMPy's fixed-step Jacobi SSP master (it logs nothing: ``verbose`` is not used)."""
     from fmpy.ssp.simulation import simulate_ssp
 
     _n, stop_time = _steps(scene, step, stop)
@@ -78,11 +152,16 @@ def run_fmpy_ssp(ssp: Path, scene: Scene, step: float, stop: float | None = None
 
 
 # ---------------------------------------------------------------------------- libcosim
-def run_libcosim(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
-    """libcosimpy (Open Simulation Platform) from the SSP; times in integer ns."""
+def run_libcosim(ssp: Path, scene: Scene, step: float, stop: float | None = None,
+                 verbose: bool = False) -> Result:
+    """libcosimpy (Open Simulation Platform) from the SSP; times in integer ns. Its log
+    (debug level by default) is cut to warnings unless ``verbose``."""
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.DEBUG if verbose else CosimLogLevel.WARNING)
 
     n, _ = _steps(scene, step, stop)
     step_ns = round(step * 1e9)
@@ -136,11 +215,16 @@ def ecos_binaries() -> Path:
     return folder
 
 
-def run_ecospy(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
-    """ecospy (Python binding of ecos) from the SSP."""
+def run_ecospy(ssp: Path, scene: Scene, step: float, stop: float | None = None,
+               verbose: bool = False) -> Result:
+    """ecospy (Python binding of ecos) from the SSP; its log at warnings unless
+    ``verbose`` (then debug)."""
     ecos_binaries()
     load_libtbb()
     from ecospy import EcosSimulation
+    from ecospy.lib import EcosLib
+
+    EcosLib.set_log_level("debug" if verbose else "warn")
 
     n, _ = _steps(scene, step, stop)
     rows: dict[str, list[float]] = {c: [] for c in ["time", *COLUMNS]}
@@ -172,25 +256,31 @@ def ecos_cli_env() -> dict[str, str]:
     return env
 
 
-def ecos_cli_command(ssp: Path, scene: Scene, step: float, stop: float) -> list[str]:
+def ecos_cli_command(ssp: Path, scene: Scene, step: float, stop: float,
+                     verbose: bool = False) -> list[str]:
     """The native ecos command line for a scene (see docs/cosimulation.md); it writes
     <ssp stem>.csv with every variable into the working directory."""
     exe = ecos_binaries() / "ecos"
     return [str(exe), "simulate", "--path", str(ssp), "--stopTime", repr(stop),
-            "--stepSize", repr(step), "--parameterSet", scene.name]
+            "--stepSize", repr(step), "--parameterSet", scene.name,
+            "--logLevel", "debug" if verbose else "warn"]
 
 
-def run_ecos_cli(ssp: Path, scene: Scene, step: float, stop: float | None = None) -> Result:
-    """The native ecos CLI, in the environment of :func:`ecos_cli_env`."""
+def run_ecos_cli(ssp: Path, scene: Scene, step: float, stop: float | None = None,
+                 verbose: bool = False) -> Result:
+    """The native ecos CLI, in the environment of :func:`ecos_cli_env`, in a temporary
+    working directory (it writes its CSV there); its output is shown if ``verbose``."""
     n, _ = _steps(scene, step, stop)
     work = Path(tempfile.mkdtemp(prefix="rotortd_ecos_"))
     try:
         env = ecos_cli_env()
         # ecos accumulates t += h in floating point and stops before a stop time it
         # would overshoot by round-off: ask for half a step more, keep n rows
-        cmd = ecos_cli_command(ssp.resolve(), scene, step, (n + 0.5) * step)
+        cmd = ecos_cli_command(ssp.resolve(), scene, step, (n + 0.5) * step, verbose)
         proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
                               timeout=1800)
+        if verbose:
+            print(proc.stdout + proc.stderr, end="", flush=True)
         path = work / f"{ssp.stem}.csv"
         if proc.returncode != 0 or not path.exists():
             raise RuntimeError(f"ecos failed ({proc.returncode}): {proc.stdout[-2000:]}"
@@ -217,7 +307,11 @@ ENGINES = {"fmpy": run_fmpy_ssp, "libcosim": run_libcosim, "ecospy": run_ecospy,
 
 
 def run(engine: str, scene: str, ssp: Path, step: float | None = None,
-        stop: float | None = None) -> Result:
-    """Run a scene on an engine."""
-    sc = ALL_SCENES[scene]
-    return ENGINES[engine](ssp, sc, sc.step if step is None else step, stop)
+        stop: float | None = None, verbose: bool = False) -> Result:
+    """Run a scene on an engine, from an SSP that carries the scene's parameters (else
+    SceneError, as for an unknown scene or engine); quiet unless ``verbose``."""
+    if engine not in ENGINES:
+        raise SceneError(f"unknown engine {engine!r}; the engines are {', '.join(ENGINES)}")
+    sc = scene_named(scene)
+    check_ssp(ssp, sc)
+    return ENGINES[engine](ssp, sc, sc.step if step is None else step, stop, verbose)

@@ -8,25 +8,35 @@ of each component sit in an inline ``ssd:ParameterBindings/ssd:ParameterValues``
 set named after the scene, with variable names unprefixed: libcosim and ecos apply it
 themselves; FMPy's ``simulate_ssp`` ignores bindings, so :mod:`.engines` passes the same
 values through its ``parameter_set`` argument (prefixed ``Component.name``).
+:func:`parameter_sets` reads them back (the engines check that an SSP carries the scene's).
 
-    python -m rotortd_cosim.ssp [--models models] [--out models/systems]
+    python -m rotortd_cosim.ssp [SCENE ...] [--models models] [--out models/systems]
+
+Without a scene it writes the documented scenes (``scenes.SCENES``); a variant such as
+``drop_torque`` (``scenes.VARIANTS``) is written when named.
 """
 
 from __future__ import annotations
 
 import argparse
+import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
-from .scenes import CONNECTIONS, FMU_FILES, RECORDED, SCENES, Scene
+from .scenes import ALL_SCENES, CONNECTIONS, FMU_FILES, RECORDED, SCENES, Scene
 
 NS = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
       'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
       'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"')
 Types = dict[str, dict[str, str]]
 """Component name -> {variable name: FMI type}, read from the built FMUs."""
+ParameterSets = dict[str, list[tuple[str, dict[str, tuple[str, str]]]]]
+"""Component name -> its parameter sets in document order: (set name, {parameter:
+(SSV type, value text)})."""
+_SSD = "{http://ssp-standard.org/SSP1/SystemStructureDescription}"
+_SSV = "{http://ssp-standard.org/SSP1/SystemStructureParameterValues}"
 
 
 def variable_types(models: Path) -> Types:
@@ -136,12 +146,38 @@ def write_all(models: Path, out_dir: Path, scenes: dict[str, Scene] | None = Non
                                                     scenes).values()]
 
 
+def parameter_sets(ssp: Path) -> ParameterSets:
+    """The inline parameter sets of every component of an SSP file (its
+    ``SystemStructure.ssd``), as the engines that apply them see them."""
+    with zipfile.ZipFile(ssp) as zf:
+        root = ET.fromstring(zf.read("SystemStructure.ssd"))
+    found: ParameterSets = {}
+    for comp in root.iter(f"{_SSD}Component"):
+        sets = found.setdefault(comp.get("name", ""), [])
+        for pset in comp.iter(f"{_SSV}ParameterSet"):
+            values = {}
+            for par in pset.iter(f"{_SSV}Parameter"):
+                kind = next(iter(par))
+                values[par.get("name", "")] = (kind.tag.removeprefix(_SSV),
+                                               kind.get("value", ""))
+            sets.append((pset.get("name", ""), values))
+    return found
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="write models/systems/<scene>.ssp")
+    parser.add_argument("scenes", nargs="*", metavar="SCENE",
+                        help=f"scenes to write, of {', '.join(ALL_SCENES)} "
+                             f"(default: {', '.join(SCENES)})")
     parser.add_argument("--models", type=Path, default=Path("models"))
     parser.add_argument("--out", type=Path, default=Path("models/systems"))
     args = parser.parse_args(argv)
-    for path in write_all(args.models, args.out):
+    unknown = [n for n in args.scenes if n not in ALL_SCENES]
+    if unknown:
+        parser.error(f"unknown scene {unknown[0]!r}; the scenes are "
+                     f"{', '.join(ALL_SCENES)}")
+    chosen = {n: ALL_SCENES[n] for n in args.scenes} if args.scenes else None
+    for path in write_all(args.models, args.out, chosen):
         print(f"ssp: wrote {path}")
     return 0
 
