@@ -392,13 +392,12 @@ FMUTOOL_MISSING = ("no fmutool on PATH and no module fmu_manipulation_toolbox; "
 
 
 def fmutool_command() -> list[str] | None:
-    """The command that runs fmutool, or None when it is not installed."""
-    exe = shutil.which("fmutool")
-    if exe:
-        return [exe]
+    """The command that runs fmutool: this interpreter's package first, else an fmutool on
+    PATH; None when neither is installed."""
     if importlib.util.find_spec("fmu_manipulation_toolbox") is not None:
         return [sys.executable, "-m", "fmu_manipulation_toolbox.cli.fmutool"]
-    return None
+    exe = shutil.which("fmutool")
+    return [exe] if exe else None
 
 
 def _fmutool_check(cmd: list[str], fmu: Path) -> list[str]:
