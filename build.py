@@ -11,8 +11,9 @@ becomes binaries/linux64/<id>.so, PythonFMU's binary moving beside it as <id>_py
 and the build interpreter's libpython is recorded in resources/rotortd_libpython.txt; with no
 C compiler the FMU keeps PythonFMU's binary alone (a warning; an error when CI=true).
 PythonFMU's win64 binary is not shipped: nothing here has run it. Finally the FMU is
-validated with fmpy and, where fmu-manipulation-toolbox is installed, `fmutool -check`; the
-script exits non-zero on any problem.
+validated with fmpy and, where fmu-manipulation-toolbox is installed (the [test] extra),
+`fmutool -check` (skipped with a message otherwise, so `pip install -e .` suffices to build);
+the script exits non-zero on any problem.
 
 To add an FMU (e.g. Drivetrain), write its adapter as a module of ``rotortd_fmi`` with a
 ``VARIABLE_META`` dict {name: (unit, min, max)}, and a few-line script in fmu_src/ that
@@ -435,30 +436,34 @@ def build_fmu(spec: FmuSpec, dest_dir: Path) -> Path:
 
 
 def validate(fmu: Path, require_fmutool: bool = False) -> list[str]:
-    """Problems found by fmpy.validation and `fmutool -check` (empty list = clean). The
-    fmutool check runs where fmu-manipulation-toolbox is installed (the [test] extra);
-    elsewhere it is skipped with a note, unless ``require_fmutool`` (the tests require it)."""
+    """Problems found by fmpy.validation and `fmutool -check` (empty list = clean).
+
+    Without fmutool (fmu-manipulation-toolbox, in the [test] extra) its check is skipped,
+    said on stdout, unless ``require_fmutool``: then its absence is a problem."""
     from fmpy.validation import validate_fmu
 
     problems = [f"fmpy: {p}" for p in validate_fmu(str(fmu))]
-    cmd = _fmutool_command()
-    if cmd is None:
-        if require_fmutool:
-            return [*problems, "fmutool: not installed (pip install -e '.[test]')"]
-        print("build: fmutool -check skipped: fmu-manipulation-toolbox is not installed "
-              "(the [test] extra installs it)")
-        return problems
-    problems += [f"fmutool: {p}" for p in _fmutool_check(cmd, fmu)]
+    cmd = fmutool_command()
+    if cmd is not None:
+        problems += [f"fmutool: {p}" for p in _fmutool_check(cmd, fmu)]
+    elif require_fmutool:
+        problems.append(f"fmutool: not installed ({FMUTOOL_MISSING})")
+    else:
+        print(f"build: {fmu.name}: fmutool -check skipped: {FMUTOOL_MISSING}")
     return problems
 
 
-def _fmutool_command() -> list[str] | None:
+FMUTOOL_MISSING = ("no fmutool on PATH and no module fmu_manipulation_toolbox; "
+                   "pip install fmu-manipulation-toolbox==2.0 (or the [test] extra) to run it")
+
+
+def fmutool_command() -> list[str] | None:
+    """The command that runs fmutool: this interpreter's package first, else an fmutool on
+    PATH; None when neither is installed."""
+    if importlib.util.find_spec("fmu_manipulation_toolbox") is not None:
+        return [sys.executable, "-m", "fmu_manipulation_toolbox.cli.fmutool"]
     exe = shutil.which("fmutool")
-    if exe:
-        return [exe]
-    if importlib.util.find_spec("fmu_manipulation_toolbox") is None:
-        return None
-    return [sys.executable, "-m", "fmu_manipulation_toolbox.cli.fmutool"]
+    return [exe] if exe else None
 
 
 def _fmutool_check(cmd: list[str], fmu: Path) -> list[str]:
@@ -490,7 +495,9 @@ def build_all(dest_dir: Path, names: list[str] | None = None, check: bool = True
                 for p in problems:
                     print(f"  - {p}")
                 raise SystemExit(1)
-            print(f"build: {fmu.name}: validated, no problems")
+            checks = "fmpy validate and fmutool -check" if fmutool_command() else \
+                "fmpy validate (fmutool -check skipped)"
+            print(f"build: {fmu.name}: {checks}: no problems")
         built.append(fmu)
     return built
 

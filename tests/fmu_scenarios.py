@@ -152,6 +152,7 @@ def sc_default_scene(fmu: str, output_interval: float = 1e-4) -> dict[str, Any]:
     return {"t_end": float(res["time"][-1]), "stop_time": float(md.defaultExperiment.stopTime),
             "rows": len(res), "r_max": float(max(res["r_rel"])),
             "n_impacts": int(res["n_impacts"][-1]), "E_diss": float(res["E_diss"][-1]),
+            "mode_end": int(res["mode"][-1]),
             "finite": bool(all(math.isfinite(v) for v in res["r_rel"]))}
 
 

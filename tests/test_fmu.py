@@ -7,6 +7,7 @@ import csv
 import io
 import json
 import math
+import os
 import subprocess
 import sys
 import zipfile
@@ -37,10 +38,20 @@ def run_scenario(fmu: Path, name: str, timeout: float = 120.0, **kwargs: Any) ->
 
 
 # ---------------------------------------------------------------------------- build / XML
-def test_fmu_validates(fmu_path: Path) -> None:
+def test_fmu_validates(fmu_path: Path, tmp_path: Path) -> None:
+    """Every FMU of build.FMU_SPECS passes fmpy validate and `fmutool -check`. build.py
+    skips fmutool where it is not installed (a lean `pip install -e .`); this test keeps
+    the check wherever it is installed, and under CI=true requires it."""
     import build
 
-    assert build.validate(fmu_path, require_fmutool=True) == []
+    require = build.fmutool_command() is not None or os.environ.get("CI") == "true"
+    fmus = [fmu_path] + [build.build_fmu(spec, tmp_path) for spec in build.FMU_SPECS
+                         if spec.name != "RotorTouchdown"]
+    for fmu in fmus:
+        assert build.validate(fmu, require_fmutool=require) == [], fmu.name
+    if not require:
+        pytest.skip("fmpy validate passed; fmutool -check not run: fmu-manipulation-toolbox "
+                    "is not installed")
 
 
 def _model_description(fmu: Path) -> ET.Element:
@@ -81,10 +92,13 @@ def test_model_description_units_structure_and_flags(fmu_path: Path) -> None:
 
 # ---------------------------------------------------------------------------- runs
 def test_default_scene_reaches_stop_time(fmu_path: Path) -> None:
+    """The default experiment shows what the component is for: impacts, then a sustained
+    rub before its stop time (the README's main job plots it)."""
     res = run_scenario(fmu_path, "default_scene", timeout=170)
     assert math.isclose(res["t_end"], res["stop_time"], rel_tol=0, abs_tol=1e-9), res
     assert res["finite"]
     assert res["r_max"] <= 1.0 + 1e-9
+    assert res["n_impacts"] > 0 and res["mode_end"] != 0, res
 
 
 def test_fmu_matches_core_bit_for_bit(fmu_path: Path) -> None:
@@ -238,8 +252,9 @@ def test_impact_log_has_one_row_per_impact(fmu_path: Path) -> None:
 
 @pytest.mark.slow
 def test_default_scene_fine_output_matches_core(fmu_path: Path) -> None:
-    """The whole default scene (0.5 s at 1e-4) bit for bit against the core."""
-    res = run_scenario(fmu_path, "match_core", params={}, n=5000, h=1e-4, timeout=900)
+    """The whole default scene (0.7 s at 1e-4: impacts, then the sliding rub) bit for bit
+    against the core."""
+    res = run_scenario(fmu_path, "match_core", params={}, n=7000, h=1e-4, timeout=900)
     assert res["n_mismatch"] == 0, res["mismatches"]
 
 

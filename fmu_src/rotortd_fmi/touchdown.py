@@ -80,7 +80,9 @@ class RotorTouchdownAdapter(GuardedSlave):
     )
     version = "0.1.0"
     license = "MIT"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=0.5, step_size=1e-4)
+    # 0.7 s: the default scene's impacts, then from 0.59 s the forward sliding rub
+    # (docs/fmu.md "The default scene")
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=0.7, step_size=1e-4)
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
