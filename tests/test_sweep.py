@@ -442,3 +442,14 @@ def test_drop_map_draws_from_a_drop_store(tmp_path):
     assert texts == ["impacting", "settled", "dry-whip"]
     fig.savefig(tmp_path / "m.png")
     assert (tmp_path / "m.png").stat().st_size > 10_000
+
+
+def test_sweep_without_its_extra_says_what_to_install() -> None:
+    """Without dask/pyarrow/tqdm (the [sweep] extra) the CLI exits 2 with one message."""
+    code = ("import sys; sys.modules['dask'] = None; sys.modules['pyarrow'] = None; "
+            "from rotortd_tools.cli import main; sys.exit(main(['sweep', 'mu=0.1', "
+            "'--out', 'x.parquet']))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert proc.returncode == 2, proc.stderr
+    assert "dask.distributed, pyarrow" in proc.stderr and '".[sweep]"' in proc.stderr

@@ -23,8 +23,30 @@ from pathlib import Path
 
 from rotortd_tools.plot import add_plot_parser
 
+SWEEP_MODULES = ("dask.distributed", "pyarrow", "tqdm")  # the [sweep] extra
+
+
+def _missing_sweep_extra(command: str) -> bool:
+    """True (after one message on stderr) when the [sweep] extra is not installed."""
+    import importlib.util
+
+    missing = []
+    for name in SWEEP_MODULES:
+        try:
+            found = importlib.util.find_spec(name) is not None
+        except (ImportError, ValueError):  # the parent package (dask) is missing
+            found = False
+        if not found:
+            missing.append(name)
+    if missing:
+        print(f"rotortd {command}: error: needs {', '.join(missing)}, from the [sweep] "
+              "extra: python -m pip install -e \".[sweep]\"", file=sys.stderr)
+    return bool(missing)
+
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    if _missing_sweep_extra("sweep"):
+        return 2
     from rotortd_tools.sweep import Settings, SweepError, parse_spec, run_sweep
 
     try:
@@ -53,6 +75,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_sweep_plot(args: argparse.Namespace) -> int:
+    if _missing_sweep_extra("sweep-plot"):
+        return 2
     from rotortd_tools.sweep import SweepError
     from rotortd_tools.sweep_plot import plot_sweep
 
