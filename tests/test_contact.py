@@ -1,4 +1,4 @@
-"""Sustained contact: chattering into rub, dry whip into rolling, lift-off, low-speed rule."""
+"""Sustained contact: chattering into rub, dry whirl into rolling, lift-off, low-speed rule."""
 
 from __future__ import annotations
 
@@ -122,7 +122,7 @@ def test_contact_entry_time_agrees_with_impact_by_impact_estimate() -> None:
     assert diffs[1] <= 3 * floor + 1e-7
 
 
-def test_dry_whip_from_rest_rolls_with_closed_form_normal_force() -> None:
+def test_dry_whirl_from_rest_rolls_with_closed_form_normal_force() -> None:
     p = _gamma(0.065)
     core = TouchdownCore(p)
     reps = _run(core, 1.0, 1e-3)  # whips at about 0.66 s (scaled time 121)

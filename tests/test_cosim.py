@@ -274,7 +274,7 @@ def test_drop_engines_agree(systems: Path) -> None:
 def test_in_process_master_is_the_engines(systems: Path) -> None:
     """rotortd_cosim.coupling.spin_jacobi (SpinCore + DriveCore with the Jacobi semantics)
     reproduces ecospy's drop scene with the PI drive bit for bit through the impacts and
-    the dry whip, so the step studies run in process."""
+    the dry whirl, so the step studies run in process."""
     from rotortd_cosim.coupling import spin_jacobi
 
     ec = run_engine(systems, "ecospy", "drop")
@@ -282,14 +282,14 @@ def test_in_process_master_is_the_engines(systems: Path) -> None:
     assert np.array_equal(np.asarray(tr.Omega), ec[OMEGA])
     assert np.array_equal(np.asarray(tr.T_drive), ec["Drivetrain.T_drive"])
     assert np.array_equal(np.asarray(tr.mode, float), ec["RotorTouchdown.mode"])
-    assert tr.mode[-1] == rotortd.MODE_ROLLING                     # dry whip at the end
+    assert tr.mode[-1] == rotortd.MODE_ROLLING                     # dry whirl at the end
 
 
 # ---------------------------------------------------------------------------- passive drive
 @pytest.mark.parametrize("engine", ENGINES)
 def test_constant_torque_coupling_equals_bearing_alone(systems: Path, engine: str) -> None:
     """Torque motor without drag (motor = 0, b = 0, T_motor_in = 2 N m): T_drive does not
-    depend on the spin, so the coupled drop into dry whip equals the RotorTouchdown FMU
+    depend on the spin, so the coupled drop into dry whirl equals the RotorTouchdown FMU
     run alone with the inputs it held (T_drive = 0 in the first step, before any drivetrain
     step, then 2 N m; amb_on from the events; on FMPy all 0 in the first step), at every
     communication point, to 1e-10 (measured: bit for bit on every engine)."""
@@ -305,7 +305,7 @@ def test_constant_torque_coupling_equals_bearing_alone(systems: Path, engine: st
             continue
         scale = max(1.0, float(np.max(np.abs(res[col]))))
         assert np.max(np.abs(alone[col] - res[col])) <= 1e-10 * scale, col
-    assert res["RotorTouchdown.mode"][-1] == rotortd.MODE_ROLLING  # through the dry whip
+    assert res["RotorTouchdown.mode"][-1] == rotortd.MODE_ROLLING  # through the dry whirl
     assert res["RotorTouchdown.n_impacts"][-1] > 100
 
 
@@ -482,7 +482,7 @@ def test_ecos_cli_constant_torque_equals_bearing_alone(systems: Path) -> None:
 PI_STEPS = (4e-4, 2e-4, 1e-4, 5e-5)
 PI_LIMIT = {0.1: 183.96427410, 0.2: 168.35494329, 0.35: 63.12398411}
 """Omega_out [rad/s] of the drop scene with the PI drive in the limit h -> 0: at 0.1 s (the
-failure; free whirl with the AMB on), 0.2 s (after 26 impacts) and 0.35 s (in dry whip,
+failure; free whirl with the AMB on), 0.2 s (after 26 impacts) and 0.35 s (in dry whirl,
 298 impacts), from the in-process master (rotortd_cosim.coupling.spin_jacobi) extrapolated
 as O(h): from h = 1e-5 and 5e-6 s at 0.1 s, from 5e-6 and 1e-6 s at 0.2 and 0.35 s
 (Omega(1e-6) = 168.35479758 and 63.12384373; the extrapolation moves them by 1.5e-4, the
@@ -496,7 +496,7 @@ def test_pi_coupling_error_is_first_order(systems: Path, engine: str) -> None:
     from the Omega of the step before): the error against the small-step limit is O(h).
     Fitted log-log slope of |Omega_out(t) - limit| over h = 4e-4 ... 5e-5 s within
     [0.8, 1.2]: at 0.1 s on every engine; on libcosim and ecospy also at 0.2 s and in the
-    dry whip at 0.35 s, with the same 298 impacts at every step. FMPy's first step (every
+    dry whirl at 0.35 s, with the same 298 impacts at every step. FMPy's first step (every
     connector at 0: amb_on = T_drive = 0 in the bearing, Omega_in = 0 in the drivetrain,
     whose PI saturates) is an O(h) perturbation too, but the impacts after the failure
     amplify it: 298 ... 318 impacts and no monotone error at these steps (measured at 0.2 s:

@@ -277,7 +277,7 @@ def test_sliding_with_gravity_and_force_against_dop853() -> None:
 
 @pytest.mark.parametrize("h", [1e-3, 1e-5])
 def test_rolling_step_against_dop853(h: float) -> None:
-    """Dry whip from rest (gamma = 0.065): rolling at theta' = -R Omega/c_r, where the
+    """Dry whirl from rest (gamma = 0.065): rolling at theta' = -R Omega/c_r, where the
     contact force is thousands of m c_r Omega^2."""
     core = TouchdownCore(_gamma(0.065))
     while core.t < 1.0 - 1e-9:

@@ -254,7 +254,7 @@ def test_chattering_ends_in_forward_rub() -> None:
     assert np.allclose(whirl / OMEGA, 1.0, rtol=0, atol=1e-8)
 
 
-def test_dry_whip_enters_rolling() -> None:
+def test_dry_whirl_enters_rolling() -> None:
     """gamma = 0.065 from rest: impacts, sliding, then rolling with theta' = -R Omega / c_r
     exactly and a normal force far above m c_r Omega^2. A later drop of Omega by 10 % at a segment
     boundary breaks rolling (v_rel jumps), the rotor slides and rolls again at the new rate."""

@@ -500,7 +500,7 @@ def test_sliding_friction_closed_form() -> None:
 
 
 def test_sliding_backward_whirl_reaches_rolling() -> None:
-    """Dry-whip onset: s = +1, θ' < 0 grows as w0/(1 + μ w0 t) until θ' = -R Ω/c_r."""
+    """Dry-whirl onset: s = +1, θ' < 0 grows as w0/(1 + μ w0 t) until θ' = -R Ω/c_r."""
     p = par(e_c=0.0, g=0.0)
     out = mp_sliding(p, 0.0, -2000.0, 0.0, OMEGA, 0, 0.0, 1.0)
     assert out["event"] == "v_rel_zero"

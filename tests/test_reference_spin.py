@@ -3,7 +3,7 @@
 agrees with
 mpmath), its stick / slide / slip-reversal outcomes, the DOP853 flight against an mpmath Taylor
 flight, exact conservation scenes, the graze search, the steady whirl helper, and the drop into
-dry whip. Nothing here imports the product core ``rotortd``.
+dry whirl. Nothing here imports the product core ``rotortd``.
 """
 
 from __future__ import annotations
@@ -306,7 +306,7 @@ def _drop(factor: float) -> SpinResult:
 
 
 @pytest.mark.parametrize("factor", [0.5, 5.0])
-def test_drop_into_dry_whip(factor: float) -> None:
+def test_drop_into_dry_whirl(factor: float) -> None:
     J = factor * M * R * R
     res = _drop(factor)
     assert res.status == "ok"

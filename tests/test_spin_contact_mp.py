@@ -2,9 +2,9 @@
 docs/model.md §8) against the 40-digit Taylor integration ``tests.reference.spin_mp.mp_contact``
 (its own coding of the equations; no shared code).
 
-Segments over 1e-4 to 1e-3 s that stay in their mode (rolling in dry whip with the bearing
+Segments over 1e-4 to 1e-3 s that stay in their mode (rolling in dry whirl with the bearing
 off and on, with and without a drive torque; sliding pressed by F_ext = -5000j N forward and
-backward, with the bearing on, in dry whip backward), and located events (slip reaching zero
+backward, with the bearing on, in dry whirl backward), and located events (slip reaching zero
 forward and backward, a lift-off). Required: the position c_r theta within 1e-12 c_r, psi within
 1e-12 rad, theta' and Omega within 1e-12 of their scales (max(|theta'|, R |Omega|/c_r) and
 max(|Omega|, c_r |theta'|/R)), the impulses int N, int F_t, int F_c within 1e-12 of
@@ -35,21 +35,21 @@ J = 0.04  # 1/2 m R^2
 R, CR = CHAPTER["R"], CHAPTER["c_r"]
 TOL = 1e-12
 BOTTOM = -math.pi / 2
-W_WHIP = 58.7  # the dry-whip rolling speed of the drop (docs/model.md §8)
+W_WHIP = 58.7  # the dry-whirl rolling speed of the drop (docs/model.md §8)
 
 # name: (s, theta, theta', psi, Omega, t, a, F_ext, T_drive, event)
 CASES: dict[str, tuple[Any, ...]] = {
-    "rolling_dry_whip": (0, BOTTOM, -R * W_WHIP / CR, 0.0, W_WHIP, 1e-3, 0.0, 0j, 0.0, None),
+    "rolling_dry_whirl": (0, BOTTOM, -R * W_WHIP / CR, 0.0, W_WHIP, 1e-3, 0.0, 0j, 0.0, None),
     "rolling_bearing_on_drive": (0, BOTTOM, -R * W_WHIP / CR, 0.3, W_WHIP, 1e-3, 1.0, 0j, 5.0,
                                  None),
     "sliding_pressed_drive": (1, BOTTOM, 10.0, 0.0, 184.2, 1e-3, 0.0, -5000j, 20.0, None),
     "sliding_pressed_bearing_on": (1, BOTTOM, 10.0, 0.0, 184.2, 1e-3, 1.0, -5000j, 0.0, None),
     "sliding_backward_pressed": (-1, BOTTOM, -300.0, 0.7, 0.5, 1e-3, 0.0, -5000j, -3.0, None),
-    "sliding_backward_dry_whip": (-1, BOTTOM, -R * 184.2 / CR - 2000.0, 0.0, 184.2, 2e-5, 0.0,
+    "sliding_backward_dry_whirl": (-1, BOTTOM, -R * 184.2 / CR - 2000.0, 0.0, 184.2, 2e-5, 0.0,
                                   0j, 0.0, None),
     # events: rem is longer than the segment
     "slip_zero_pressed": (1, BOTTOM, 0.0, 0.0, 1.0, 3e-3, 0.0, -5000j, 0.0, "slip_zero"),
-    "slip_zero_dry_whip": (-1, BOTTOM, -R * 184.2 / CR - 2000.0, 0.0, 184.2, 1e-4, 0.0, 0j, 0.0,
+    "slip_zero_dry_whirl": (-1, BOTTOM, -R * 184.2 / CR - 2000.0, 0.0, 184.2, 1e-4, 0.0, 0j, 0.0,
                            "slip_zero"),
     "lift_off_at_top": (1, math.pi / 2, 110.0, 0.0, 184.2, 3e-3, 0.0, 0j, 0.0, "lift_off"),
 }

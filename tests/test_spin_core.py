@@ -59,7 +59,7 @@ def test_conservation_scene_keeps_momentum_and_energy(d: float) -> None:
 
 
 @pytest.mark.parametrize("T_drive", [0.0, 5.0])
-def test_energy_balance_closes_through_the_drop_into_dry_whip(T_drive: float) -> None:
+def test_energy_balance_closes_through_the_drop_into_dry_whirl(T_drive: float) -> None:
     """The drop from the levitated whirl (bearing off from t = 0, gravity, the chapter's
     rotor, J = m R^2/2): the change of T + V equals the drive's work T_drive dpsi minus
     the dissipation, with a residual below 1e-10 of the sum of the terms' magnitudes."""
@@ -73,7 +73,7 @@ def test_energy_balance_closes_through_the_drop_into_dry_whip(T_drive: float) ->
     assert abs(sum(terms)) <= 1e-10 * sum(abs(x) for x in terms)
 
 
-def test_dry_whip_rolls_backward_and_stays_rolling() -> None:
+def test_dry_whirl_rolls_backward_and_stays_rolling() -> None:
     """After the drop the rotor rolls backward round the bearing (whirl = -R Omega/c_r),
     and stays in mode 2 at every communication point once there."""
     core = SpinCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)

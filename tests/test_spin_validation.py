@@ -70,8 +70,8 @@ def _drop(J: float, h: float, dz: float = 0.0) -> tuple[np.ndarray, np.ndarray, 
 
 
 @pytest.mark.parametrize("J_over_mR2", [0.5, 5.0])
-def test_drop_into_dry_whip_matches_the_reference(J_over_mR2: float) -> None:
-    """The drop at 184.2 rad/s into dry whip: Omega at every communication point, the
+def test_drop_into_dry_whirl_matches_the_reference(J_over_mR2: float) -> None:
+    """The drop at 184.2 rad/s into dry whirl: Omega at every communication point, the
     times of entering contact and rolling, the mean whip speed over the last 0.1 s, mode 2
     kept; steps of 1e-4 and 1e-3 s agree within 100 A 1e-12."""
     J = J_over_mR2 * P.m * P.R ** 2

@@ -218,7 +218,7 @@ def test_degenerate_dynamics(case: str) -> None:
 @pytest.mark.parametrize("h", [1e-9, 1e-7, 1e-5, 1e-3, 0.1, 1.0, 10.0])
 def test_step_sizes_from_1ns_to_10s(h: float) -> None:
     """One step size per run over the whole range, chattering scene (gamma = 0.3 from rest)
-    and dry whip (0.065): at most 0.5 s of simulated time or one step."""
+    and dry whirl (0.065): at most 0.5 s of simulated time or one step."""
     for gamma in (0.3, 0.065):
         core = TouchdownCore(_chapter(gamma=gamma))
         n = max(1, min(2000, round(0.5 / h)))

@@ -137,7 +137,7 @@ def test_detect_period_and_classify():
     assert sw.classify(10, 0.0, 0.0, 3) == "period-3"
     assert sw.classify(10, 0.1, 0.0, 0) == "irregular"
     assert sw.classify(0, 0.9, 0.1, 0) == "rub"
-    assert sw.classify(0, 0.0, 1.0, 0) == "whip"
+    assert sw.classify(0, 0.0, 1.0, 0) == "dry-whirl"
     assert sw.regime_group("period-7") == "period-n"
 
 
@@ -158,7 +158,7 @@ def test_chapter_regimes_from_named_starts():
     assert rub["regime"] == "rub" and rub["final_mode"] == MODE_SLIDING
     assert rub["contact_frac"] == pytest.approx(1.0) and rub["r_min"] == pytest.approx(1.0)
     whip = _run(0.065, "rest")
-    assert whip["regime"] == "whip" and whip["final_mode"] == MODE_ROLLING
+    assert whip["regime"] == "dry-whirl" and whip["final_mode"] == MODE_ROLLING
     below = _run(0.065, "steady")
     assert below["regime"] == "no-start" and "not admissible" in below["message"]
 
@@ -223,7 +223,7 @@ def test_dask_local_cluster_equals_serial(tmp_path):
     assert len(a) == 7 * len(spec.starts)
     _assert_identical(a, b)
     regimes = {r["regime"] for r in a.values()}
-    assert {"free", "rub", "whip"} <= regimes
+    assert {"free", "rub", "dry-whirl"} <= regimes
 
 
 def test_resume_refuses_a_different_sweep(tmp_path):
@@ -343,7 +343,7 @@ DROP = sw.Settings(drop_time=0.15, drop_window=0.03, drop_step=1e-4)
 
 
 def test_two_point_drop_sweep_with_J_records_outcomes(tmp_path):
-    """mu = 0.15, J = 0.04 and 1.6 kg m^2: both drops end in dry whip; the whip speed is
+    """mu = 0.15, J = 0.04 and 1.6 kg m^2: both drops end in dry whirl; the whip speed is
     the rolling relation theta' = -R Omega / c_r, and the heavier spin keeps more speed."""
     spec = sw.parse_spec(["J=0.04:1.6:log2", "mu=0.15"], "drop")
     counts = sw.run_sweep(spec, DROP, tmp_path / "d", serial=True)
@@ -352,14 +352,14 @@ def test_two_point_drop_sweep_with_J_records_outcomes(tmp_path):
     assert [r["J"] for r in rows] == [0.04, 1.6] and [r["T_drive"] for r in rows] == [0, 0]
     p = sw.point_params({})[0]
     for r in rows:
-        assert r["status"] == "ok" and r["regime"] == "dry-whip", r
+        assert r["status"] == "ok" and r["regime"] == "dry-whirl", r
         assert r["regime"] in sw.DROP_OUTCOMES and r["final_mode"] == MODE_ROLLING
         assert r["roll_frac"] == pytest.approx(1.0) and r["slip_ratio"] < 1e-9
         assert r["whirl_mean"] == pytest.approx(-p.R * r["Omega_mean"] / p.c_r, rel=1e-3)
         assert 0.0 < r["Omega_mean"] < r["Omega"] and r["Omega_end"] > 0.0
     assert rows[1]["Omega_mean"] > 2.0 * rows[0]["Omega_mean"]
     meta = sw.read_meta(tmp_path / "d")
-    assert meta["format"] == sw.FORMAT_VERSION == 2 and meta["axes"][0]["log"] is True
+    assert meta["format"] == sw.FORMAT_VERSION == 3 and meta["axes"][0]["log"] is True
 
 
 def test_spin_state_runs_without_drop_and_held_rows_have_no_J():
@@ -401,18 +401,18 @@ def test_classify_drop_classes_and_threshold_boundaries():
     assert _drop(1, 0.0, 0.0) == "impacting"
     assert _drop(0, 0.01, 0.0) == "impacting"  # touched without impact: not no-contact
     assert _drop(30, 0.2, 0.2999) == "impacting"  # contact just below half the window
-    assert _drop(30, 0.2, 0.3) == "dry-whip"  # contact at half the window: sustained
+    assert _drop(30, 0.2, 0.3) == "dry-whirl"  # contact at half the window: sustained
     assert _drop(0, 1.0, 0.0, whirl=150.0, ratio=0.9) == "forward-rub"
-    assert _drop(0, 1.0, 0.0, whirl=-3000.0, ratio=0.2) == "backward-whirl"
-    assert _drop(0, 0.0, 1.0, whirl=-3000.0, ratio=0.0) == "dry-whip"
-    assert _drop(0, 0.5, 0.5, whirl=-3000.0, ratio=SLIP_ROLL) == "dry-whip"
-    assert _drop(0, 0.5, 0.5, whirl=-3000.0, ratio=SLIP_ROLL * 1.001) == "backward-whirl"
+    assert _drop(0, 1.0, 0.0, whirl=-3000.0, ratio=0.2) == "dry-whip"
+    assert _drop(0, 0.0, 1.0, whirl=-3000.0, ratio=0.0) == "dry-whirl"
+    assert _drop(0, 0.5, 0.5, whirl=-3000.0, ratio=SLIP_ROLL) == "dry-whirl"
+    assert _drop(0, 0.5, 0.5, whirl=-3000.0, ratio=SLIP_ROLL * 1.001) == "dry-whip"
     assert _drop(0, 0.0, 1.0, whirl=-turn * 0.999) == "settled"  # rocking at the bottom
     assert _drop(0, 0.0, 1.0, whirl=turn * 0.999, ratio=0.5) == "settled"
-    assert _drop(0, 0.0, 1.0, whirl=-turn * 1.001) == "dry-whip"
+    assert _drop(0, 0.0, 1.0, whirl=-turn * 1.001) == "dry-whirl"
     assert _drop(0, 1.0, 0.0, whirl=turn * 1.001, ratio=0.5) == "forward-rub"
     # the whirl's sense is taken against the spin: a reversed spin rolling forward whips
-    assert _drop(0, 0.0, 1.0, W=-4.0, whirl=230.0) == "dry-whip"
+    assert _drop(0, 0.0, 1.0, W=-4.0, whirl=230.0) == "dry-whirl"
     assert _drop(0, 1.0, 0.0, W=-4.0, whirl=-230.0, ratio=0.5) == "forward-rub"
     assert _drop(0, 1.0, 0.0, W=0.0, whirl=230.0, ratio=0.5) == "forward-rub"
 
@@ -423,7 +423,7 @@ def test_drop_recorder_summary_normalises_the_slip():
     s = rec.summary(R=0.04, c_r=7e-4)
     assert s["Omega_mean"] == 100.0 and s["whirl_mean"] == -2000.0
     assert s["slip_ratio"] == pytest.approx(0.05 / 4.0)  # R Omega = 4 > c_r theta' = 1.4
-    assert s["contact_frac"] == pytest.approx(1.0) and s["regime"] == "backward-whirl"
+    assert s["contact_frac"] == pytest.approx(1.0) and s["regime"] == "dry-whip"
 
 
 def test_drop_map_draws_from_a_drop_store(tmp_path):
@@ -433,13 +433,13 @@ def test_drop_map_draws_from_a_drop_store(tmp_path):
 
     mu, J = np.array([0.05, 0.5, 0.05, 0.5]), np.array([1e-3, 1e-3, 1.0, 1.0])
     cols = {"mu": mu, "J": J, "Omega": np.full(4, 184.2), "start": np.array(["drop"] * 4),
-            "regime": np.array(["impacting", "settled", "impacting", "dry-whip"]),
+            "regime": np.array(["impacting", "settled", "impacting", "dry-whirl"]),
             "whirl_mean": np.array([10.0, 0.5, 100.0, -9000.0]),
             "Omega_mean": np.array([10.0, 0.1, 180.0, 170.0])}
     fig = drop_map(cols, ["mu", "J"], {}, {"mu": True, "J": True})
     assert [ax.get_xscale() for ax in fig.axes[:3]] == ["log"] * 3
     texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert texts == ["impacting", "settled", "dry-whip"]
+    assert texts == ["impacting", "settled", "dry-whirl"]
     fig.savefig(tmp_path / "m.png")
     assert (tmp_path / "m.png").stat().st_size > 10_000
 

@@ -22,7 +22,7 @@ amplified at most like a start error:
 * t_q/h: every communication step restarts the exact flight from a float64 state, so each
   step adds about one rounding of the state (the error therefore grows as h shrinks);
 * (1 + |v|)/rdot per impact: the event-location limit of docs/model.md §3, eps c_r/rdot, with the
-  flight's rounding scaled by the speed |v| (large in dry whip, |v| ~ R Omega);
+  flight's rounding scaled by the speed |v| (large in dry whirl, |v| ~ R Omega);
 * K_ROUND = 4: "a small multiple" -- the largest ratio measured over all 11 scenes, 4 steps
   and both interfaces when the rule was set was 1.3 (docs/validation.md).
 

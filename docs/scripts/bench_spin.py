@@ -1,9 +1,9 @@
-"""Cost of the spin as a state: the drop into dry whip through FMPy, and per contact mode.
+"""Cost of the spin as a state: the drop into dry whirl through FMPy, and per contact mode.
 
     python docs/scripts/bench_spin.py               # ~3 min (timing + callgrind)
     python docs/scripts/bench_spin.py --no-valgrind # timing only
 
-1. Timed, one process: ``fmpy.simulate_fmu`` runs the drop into dry whip (the chapter's
+1. Timed, one process: ``fmpy.simulate_fmu`` runs the drop into dry whirl (the chapter's
    rotor with g = 9.81, J = m R^2/2 = 0.04 kg m^2, integrate_spin, from the levitated
    steady whirl at 184.2 rad/s with the bearing failed from t = 0) for 0.3 s at the
    communication step 1e-4 s, and the same on the floor FMU (benchmarks.py: the same
@@ -14,7 +14,7 @@
    in each kind of segment: free flight in closed form (bearing off, the imbalance orbit
    inside the clearance), free flight integrated (bearing on, the levitated whirl), sliding
    (pressed to the wall by F_ext with a drive torque balancing the friction) and rolling
-   (dry whip, after the drop), each as the difference of two runs of different length
+   (dry whirl, after the drop), each as the difference of two runs of different length
    after the same warm-up, so start-up and warm-up cancel.
 Writes docs/bench_spin.json; docs/benchmarks.md quotes it.
 """
@@ -61,7 +61,7 @@ elif kind == "flight_integrated":  # bearing on: the levitated whirl, Omega slow
 elif kind == "sliding":          # pressed down, the drive torque balancing the friction
     core = SpinCore(p, J, Omega0=184.2)
     warm, ins = 1000, {"amb_on": 0.0, "F_ext": -5000j, "T_drive": 0.04 * 0.15 * 5490.5}
-else:                            # rolling: dry whip after the drop
+else:                            # rolling: dry whirl after the drop
     core = SpinCore.on_steady_whirl(p, 184.2, J=J)
     warm, ins = 1000, {"amb_on": 0.0}
 for _ in range(warm + n):
@@ -107,8 +107,9 @@ def timed(repeats: int) -> dict[str, Any]:
            "steps": round(T_END / H), "first_rolling_s": first_roll,
            "Omega_end": float(res["Omega_out"][-1]),
            "rolling_at_every_step_after": bool(np.all(modes[modes.argmax():] == 2))}
-    print(f"drop into dry whip, {out['steps']} steps of {H:g} s: FMU {statistics.median(t_fmu):.3f}"
-          f" s CPU, floor {statistics.median(t_floor):.3f} s; FMU/floor = {out['ratio']:.2f} "
+    print(f"drop into dry whirl, {out['steps']} steps of {H:g} s: FMU "
+          f"{statistics.median(t_fmu):.3f} s CPU, floor {statistics.median(t_floor):.3f} s; "
+          f"FMU/floor = {out['ratio']:.2f} "
           f"(target <= 10); {out['fmu_cpu_per_simulated_s']:.2f} s CPU per simulated second")
     return out
 

@@ -131,7 +131,7 @@ def make_scenes() -> list[Scene]:
               cyc.params, complex(zm), complex(vm), W * cyc.T_si / 2),
         Scene("chattering", "chattering into rub, gamma = 0.3 from rest", p_whirl, 0j, 0j,
               0.0, prefix_only=True),
-        Scene("dry_whip", "dry whip, gamma = 0.065 from rest",
+        Scene("dry_whirl", "dry whirl, gamma = 0.065 from rest",
               si_params(chapter_params(gamma=0.065)), 0j, 0j, 0.0, prefix_only=True),
         Scene("drop", "bearing-off drop, g = 9.81, amb_on -> 0 at 0.1 s (gamma = 0.152)",
               p_drop, drop.z, drop.v, 0.0, t_off=0.1, start_steady=True, prefix_only=True),

@@ -32,7 +32,7 @@ COLORS = {
     "free whirl": "tab:green",
     "impacting": "tab:blue",
     "rub/sliding": "tab:orange",
-    "dry whip/rolling": "tab:red",
+    "dry whirl/rolling": "tab:red",
 }
 MARKERS = {"rest": "o", "near U*": "s", "cycle": "^", "large orbit": "D"}
 

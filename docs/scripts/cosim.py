@@ -7,7 +7,7 @@ speed, orbit, contact force and mode to docs/img/cosim_<scene>.png, and measures
 coupling error of the drop scene with the PI drive against the communication step with the
 in-process master (rotortd_cosim.coupling.spin_jacobi, bit-identical to ecospy): the error
 at 0.2 s, at 0.35 s and the largest over the run, against the O(h)-extrapolated limit of
-h = 1e-5 and 5e-6 s; and the former held-Omega coupling's chatter in the dry whip
+h = 1e-5 and 5e-6 s; and the former held-Omega coupling's chatter in the dry whirl
 (docs/img/cosim_coupling.png, printed).
 """
 
@@ -134,7 +134,7 @@ def coupling_study() -> Path:
     print(f"CPU {time.process_time() - t0:.0f} s")
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
     for key, label in (("err_0.2", "at 0.2 s (26 impacts)"),
-                       ("err_0.35", "at 0.35 s (dry whip)"),
+                       ("err_0.35", "at 0.35 s (dry whirl)"),
                        ("err_roll", "largest while rolling (t > 0.265 s)"),
                        ("err_max", "largest 0.5 ms or more from an impact")):
         ax[0].loglog(hs, [r[key] for r in rows], "o-", label=label)
@@ -149,7 +149,7 @@ def coupling_study() -> Path:
     ax[1].plot(spin.time, spin.Omega, lw=1.0, label="spin a state (integrate_spin), h = 1e-4")
     ax[1].plot(t_grid, lim, "k--", lw=0.8, label="spin a state, limit h -> 0")
     ax[1].set(xlabel="t [s]", ylabel="Omega [rad/s]", xlim=(0.24, DROP.stop_time),
-              title="into dry whip: held Omega chatters, the spin state does not")
+              title="into dry whirl: held Omega chatters, the spin state does not")
     ax[1].legend()
     fig.tight_layout()
     path = IMG / "cosim_coupling.png"

@@ -34,7 +34,7 @@ benchmark scenes of docs/scripts/benchmarks.py (1 s each; their start values fro
 ``--check-scenes`` compares them with ``benchmarks.make_scenes()``), (c) a bearing-failure
 drop: chapter rotor, g = 9.81, levitated steady whirl at 184.2 rad/s, amb_on 1 -> 0 at
 10 ms, 0.3 s, (d) the spin as a state (SPIN; ``SpinCore``, the scenes of docs/spin.md and
-docs/scripts/bench_spin.py): the drop into dry whirl (rolling; the pages' "dry whip") from
+docs/scripts/bench_spin.py): the drop into dry whirl (rolling backward whirl) from
 the levitated whirl with the bearing failed, J = m R^2/2 and 5 m R^2, 0.3 s; pressed
 sliding (F_ext = -5000j N, the drive torque R mu N balancing the friction), 0.2 s; the
 levitated whirl with the bearing on (integrated flight), 0.1 s; closed-form flight (bearing
@@ -180,7 +180,7 @@ BENCH: dict[str, tuple[dict[str, str], tuple[str, ...], float, bool]] = {
                      "-0x1.6729d9a37b1edp-4", "0x1.9a16476e2a5fdp-6",
                      "0x1.6e8797226e98ap+0"), math.inf, False),
     "chattering": ({"c": "0x1.5960000000000p+11"}, ("0x0.0p+0",) * 5, math.inf, False),
-    "dry_whip": ({"c": "0x1.2b53333333333p+9"}, ("0x0.0p+0",) * 5, math.inf, False),
+    "dry_whirl": ({"c": "0x1.2b53333333333p+9"}, ("0x0.0p+0",) * 5, math.inf, False),
     "drop": ({"c": "0x1.5e00000000000p+10", "g": _G981}, _DROP_START, 0.1, True),
 }
 BENCH_T_END = 1.0

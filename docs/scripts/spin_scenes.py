@@ -4,7 +4,7 @@
 
 Runs the scenes of the spin as a state (docs/model.md §8) with ``rotortd.SpinCore`` and the
 independent reference (``tests/reference/spin_reference.py``, scipy DOP853 at rtol 1e-12):
-the drop from the levitated whirl into dry whip (J = m R^2/2 and 5 m R^2), the run-down with
+the drop from the levitated whirl into dry whirl (J = m R^2/2 and 5 m R^2), the run-down with
 the drive through impacts and a forward rub, the run-up through the critical speed (1 N m
 passes, 0.1 N m is held below), and the balances of tests/test_spin_core.py. Writes
 docs/img/spin_*.png and docs/spin_scenes.json (the figures' key numbers).
@@ -273,7 +273,7 @@ def drop_scene(r: dict) -> dict[str, Any]:
                label="SpinCore, every 25th 1e-4 s point")
         _mark(a, ts, tr)
         a.set(ylabel="Omega [rad/s]",
-              title=f"drop into dry whip, J = {J:g} kg m^2 ({J / (P_G.m * P_G.R**2):g} m R^2)")
+              title=f"drop into dry whirl, J = {J:g} kg m^2 ({J / (P_G.m * P_G.R**2):g} m R^2)")
         a.legend(fontsize=8, loc="upper right")
         a = ax[1, col]
         a.plot(t, core["mode"], drawstyle="steps-post", color="tab:blue", label="SpinCore")

@@ -46,7 +46,7 @@ from tests import validation_lib as V  # noqa: E402
 DOCS = ROOT / "docs"
 IMG = DOCS / "img"
 APIS = ("api", "cli")
-ORBIT_SCENES = ("Cycle_g0065", "Chatter_to_rub", "Dry_whip_rolling", "AMB_drop")
+ORBIT_SCENES = ("Cycle_g0065", "Chatter_to_rub", "Dry_whirl_rolling", "AMB_drop")
 
 
 def build_fmu(dest: Path) -> Path:

@@ -11,7 +11,7 @@ with its held drive torque ``T_drive`` (N m); its spin is then the core's own.
 
 The drop (``run_drop``, SI units, seconds): the bearing off (amb_on = 0) for a fixed number
 of steps, the last ones recorded by a ``DropRecorder``; ``classify_drop`` names the outcome
-(no-contact, impacting, settled, forward-rub, backward-whirl, dry-whip; docs/sweeps.md).
+(no-contact, impacting, settled, forward-rub, dry-whip, dry-whirl; docs/sweeps.md).
 """
 
 from __future__ import annotations
@@ -25,16 +25,16 @@ import numpy as np
 from rotortd import MODE_FREE, MODE_ROLLING, MODE_SLIDING, STATUS_OK, TouchdownCore
 from rotortd.scaled import wrap_angle
 
-CHAPTER_REGIMES = ("free whirl", "impacting", "rub/sliding", "dry whip/rolling")
+CHAPTER_REGIMES = ("free whirl", "impacting", "rub/sliding", "dry whirl/rolling")
 """The chapter's coarse regimes (``chapter_regime``)."""
 MOST = 0.5
 """"At least half the window" (``>= MOST``): the fraction rule of ``classify``."""
-DROP_OUTCOMES = ("no-contact", "impacting", "settled", "forward-rub", "backward-whirl",
-                 "dry-whip")
+DROP_OUTCOMES = ("no-contact", "impacting", "settled", "forward-rub", "dry-whip",
+                 "dry-whirl")
 """The drop outcomes of ``classify_drop``, in the order they are tested."""
 SLIP_ROLL = 0.01
 """Largest slip ratio (mean |v_rel| over the larger of R |Omega| and c_r |theta'|) of a
-dry whip; above it a backward whirl is sliding."""
+dry whirl (rolling backward whirl); above it the backward whirl slides: dry whip."""
 WHIRL_TURNS = 1.0
 """Fewest turns round the bearing (|mean theta'| window / 2 pi) of a whirl; below it the
 rotor in contact is ``settled`` (lying or rocking at the bottom)."""
@@ -144,11 +144,11 @@ def detect_period(angles: Sequence[float], speeds: Sequence[float], tol: float,
 def classify(n_impacts: int, slide_frac: float, roll_frac: float, period: int) -> str:
     """Regime from the record window's signature.
 
-    whip (rolling at least half the time), rub (in contact at least half the time),
+    dry-whirl (rolling at least half the time), rub (in contact at least half the time),
     free (no impact, no contact), period-<n> (impact map n-periodic), else irregular.
     """
     if roll_frac >= MOST:
-        return "whip"
+        return "dry-whirl"
     if slide_frac + roll_frac >= MOST:
         return "rub"
     if n_impacts == 0 and slide_frac + roll_frac == 0.0:
@@ -167,9 +167,9 @@ def regime_group(regime: str) -> str:
 
 
 def chapter_regime(regime: str, n_impacts: int) -> str:
-    """The chapter's coarse regime (CHAPTER_REGIMES) of a ``classify`` regime: whip and rub
+    """The chapter's coarse regime (CHAPTER_REGIMES) of a ``classify`` regime: dry-whirl and rub
     as they are, otherwise impacting when there was an impact, else free whirl."""
-    if regime == "whip":
+    if regime == "dry-whirl":
         return CHAPTER_REGIMES[3]
     if regime == "rub":
         return CHAPTER_REGIMES[2]
@@ -269,22 +269,22 @@ def classify_drop(n_impacts: int, slide_frac: float, roll_frac: float, Omega_mea
     slip_ratio: mean |v_rel| over max(R |Omega_mean|, c_r |whirl_mean|); t_window (s).
 
       no-contact      no impact and no contact in the window (``classify``'s free)
-      impacting       in contact less than half the window (``classify``: not rub/whip)
+      impacting       in contact less than half the window (``classify``: not rub/dry-whirl)
       settled         in contact, but less than WHIRL_TURNS turns round the bearing:
                       |whirl_mean| t_window < 2 pi WHIRL_TURNS (lying or rocking)
       forward-rub     whirling with the spin: whirl_mean Omega_mean > 0 (Omega_mean >= 0
                       counts as positive)
-      dry-whip        whirling against the spin, rolling: slip_ratio <= SLIP_ROLL
-      backward-whirl  whirling against the spin, sliding: slip_ratio > SLIP_ROLL
+      dry-whirl        whirling against the spin, rolling: slip_ratio <= SLIP_ROLL
+      dry-whip        whirling against the spin, sliding: slip_ratio > SLIP_ROLL
     """
     regime = classify(n_impacts, slide_frac, roll_frac, 0)
     if regime == "free":
         return "no-contact"
-    if regime not in ("rub", "whip"):
+    if regime not in ("rub", "dry-whirl"):
         return "impacting"
     if abs(whirl_mean) * t_window < 2.0 * math.pi * WHIRL_TURNS:
         return "settled"
     sense = 1.0 if Omega_mean >= 0.0 else -1.0
     if sense * whirl_mean > 0.0:
         return "forward-rub"
-    return "dry-whip" if slip_ratio <= SLIP_ROLL else "backward-whirl"
+    return "dry-whirl" if slip_ratio <= SLIP_ROLL else "dry-whip"

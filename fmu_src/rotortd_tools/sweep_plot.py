@@ -45,7 +45,7 @@ COLOURS = {
     "period-n": "tab:purple",
     "irregular": "tab:orange",
     "rub": "tab:red",
-    "whip": "black",
+    "dry-whirl": "black",
     "no-start": "0.85",
     "failed": "magenta",
 }
@@ -54,8 +54,8 @@ DROP_COLOURS = {
     "impacting": "tab:blue",
     "settled": "0.6",
     "forward-rub": "tab:red",
-    "backward-whirl": "tab:orange",
-    "dry-whip": "black",
+    "dry-whip": "tab:orange",
+    "dry-whirl": "black",
     "no-start": "0.9",
     "failed": "magenta",
 }
@@ -329,7 +329,7 @@ def drop_map(cols: dict[str, np.ndarray], names: list[str], fixed: dict[str, flo
              logs: dict[str, bool] | None = None):
     """Three maps of a two-parameter drop sweep (``--starts drop``): the outcome
     (``classify_drop``), the mean whirl rate over the window |theta'| / 2 pi (Hz; the whip
-    speed where the outcome is a backward whirl or dry whip), and the spin kept,
+    speed where the outcome is a backward whirl or dry whirl), and the spin kept,
     Omega_mean / Omega (the initial spin). With J an axis, the well-posedness bound
     J = m mu e_c (R + e_c) (kg m^2) is drawn dashed when mu is the other axis."""
     import matplotlib.pyplot as plt
@@ -352,7 +352,7 @@ def drop_map(cols: dict[str, np.ndarray], names: list[str], fixed: dict[str, flo
     code = {g: k for k, g in enumerate(DROP_REGIMES)}
     outcome = grid([code.get(r, code["failed"]) for r in regimes])
     whirl = np.abs(cols["whirl_mean"].astype(float)) / (2.0 * np.pi)
-    whip = np.array([r in ("dry-whip", "backward-whirl") for r in regimes])
+    whip = np.array([r in ("dry-whirl", "dry-whip") for r in regimes])
     kept = cols["Omega_mean"].astype(float) / cols["Omega"].astype(float)
     fig, axes = plt.subplots(1, 3, figsize=(17, 5.6), layout="constrained", sharey=True)
     ax = axes[0]
@@ -375,7 +375,7 @@ def drop_map(cols: dict[str, np.ndarray], names: list[str], fixed: dict[str, flo
         cs = ax.contour(xs, ys, Zw, levels=[30, 100, 300, 1000], colors="w",
                         linewidths=0.6, linestyles=":")
         ax.clabel(cs, fmt="%g Hz", fontsize=7)
-    ax.set_title("whirl speed (white line: backward whirl / dry whip inside)")
+    ax.set_title("whirl speed (white line: backward whirl / dry whirl inside)")
     ax = axes[2]
     m = ax.pcolormesh(ex, ey, grid(kept), cmap="magma", vmin=min(0.0, np.nanmin(kept)),
                       vmax=1.0)

@@ -209,7 +209,7 @@ def build_scenes() -> list[Scene]:
                         "chattering, accumulation, sliding onto the forward rub", p03, 0j, 0j,
                         0.25))
     p065 = _scaled_si(0.065)
-    scenes.append(Scene("Dry_whip_rolling", "gamma = 0.065, synthetic backward-whirl start at "
+    scenes.append(Scene("Dry_whirl_rolling", "gamma = 0.065, synthetic backward-whirl start at "
                         "0.99 c_r with v = 0.1 c_r Omega (radial) - 0.9 R Omega i: friction "
                         "(stick cap) drives v_rel to 0, the rotor rolls", p065,
                         0.99 * p065["c_r"] + 0j,
@@ -219,7 +219,7 @@ def build_scenes() -> list[Scene]:
                         "from rest at the centre", pc, 0j, 0j, 0.1))
     z, v, psi, _ = _on_cycle(0.1, "long-large")
     scenes.append(Scene("High_friction", "gamma = 0.1, mu = 1 started on the mu = 0.15 cycle: "
-                        "chattering, sliding, dry whip into rolling", _scaled_si(0.1, mu=1.0), z,
+                        "chattering, sliding, dry whirl into rolling", _scaled_si(0.1, mu=1.0), z,
                         v, 0.05, psi0=psi))
     pd = _scaled_si(C.chapter_params().gamma, g=9.81)
     scenes.append(Scene("AMB_drop", "chapter set, horizontal rotor (g = 9.81, bias force on), at "

@@ -8,7 +8,7 @@ from typing import Any
 from rotortd_tools.attractor import DROP_OUTCOMES
 from rotortd_tools.sweep.spec import PARAM_NAMES
 
-REGIMES = ("free", "period-1", "period-2", "period-n", "irregular", "rub", "whip",
+REGIMES = ("free", "period-1", "period-2", "period-n", "irregular", "rub", "dry-whirl",
            "no-start", "failed")
 """Regime groups (``regime`` itself says ``period-<n>`` with the exact n)."""
 DROP_REGIMES = (*DROP_OUTCOMES, "no-start", "failed")

@@ -15,7 +15,7 @@ from rotortd_tools.sweep.schema import arrow_schema
 from rotortd_tools.sweep.spec import Settings, SweepError, SweepSpec
 
 META_FILE = "_sweep.json"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3  # 3: the drop outcomes named as the literature does (dry-whirl, dry-whip)
 """Store format: 2 added the columns J, T_drive, Omega_end, Omega_mean, whirl_mean,
 slip_mean, slip_ratio and the drop settings. A format-1 store is still read (``read_sweep``,
 ``rotortd sweep-plot``) but is not resumed."""
@@ -119,8 +119,11 @@ def prepare_output(path: Path, spec: SweepSpec, settings: Settings, overwrite: b
     if old is not None and old.get("format") != FORMAT_VERSION:
         raise SweepError(
             f"output {path} holds a sweep in store format {old.get('format')!r}, this is "
-            f"format {FORMAT_VERSION} (columns J, T_drive, Omega_end, Omega_mean, "
-            "whirl_mean, slip_mean, slip_ratio were added): it can still be read "
+            f"format {FORMAT_VERSION} (format 2 added the columns J, T_drive, Omega_end, "
+            "Omega_mean, whirl_mean, slip_mean, slip_ratio; format 3 renamed the regime "
+            "whip and the drop outcome dry-whip (both rolling) to dry-whirl and the drop "
+            "outcome backward-whirl (sliding) to dry-whip, as the rotordynamics literature "
+            "names them): it can still be read "
             "(read_sweep, sweep-plot) but not resumed; use --overwrite or another --out"
         )
     if old is not None:
