@@ -11,6 +11,10 @@ frictional impacts at random states
   energetic cap lowered it), and the slip at the law's v_rel+;
 * never create energy.
 
+A second test-only counter-body, ``OscillatingRing``, moves its centre on a known path: the
+free-flight search (``rotortd.spin_flight.SpinFlight`` with ``bearing=``) finds a grazing
+contact with it, at the analytic time, and only because it adds the path's bounds.
+
 And the chapter's case: the held-speed rotor (``RigidRotor.held``, J = inf) on the fixed
 rigid bearing gives the held reset law ``impact.reset`` (a declared accelerator) to
 rounding.
@@ -147,3 +151,56 @@ def test_held_rotor_on_the_fixed_bearing_is_the_held_reset_law() -> None:
         err = abs(v_plus - held.v_plus) / (abs(v) + R * abs(Omega))
         worst = max(worst, err, abs(r.P_n - held.P_n) / (M * (abs(v) + R * abs(Omega))))
     assert worst <= 4e-15, worst
+
+
+class OscillatingRing:
+    """A test-only counter-body whose centre moves on a known path, c(s) = A sin(nu s) on
+    the x axis (m; s from the flight's start), with the bounds the search needs."""
+
+    moves = True
+
+    def __init__(self, *, c_r: float, A: float, nu: float) -> None:
+        self.c_r, self.A, self.nu, self.rate = c_r, A, nu, nu
+
+    def path(self, s: float) -> tuple[complex, complex, complex, complex]:
+        A, nu = self.A, self.nu
+        sn, cs = math.sin(nu * s), math.cos(nu * s)
+        return (complex(A * sn), complex(A * nu * cs), complex(-A * nu * nu * sn),
+                complex(-A * nu ** 3 * cs))
+
+    def path_bounds(self, s: float, tau: float) -> tuple[float, float, float, float, float]:
+        A, nu = self.A, self.nu
+        return (A, A * nu, A * nu * nu, A * nu ** 3, A * nu ** 4)
+
+
+@pytest.mark.parametrize("excess", [1e-6, 1e-9, 1e-12, -1e-9])
+def test_search_finds_a_grazing_contact_with_a_moving_circle(excess: float) -> None:
+    """A rotor at rest at the origin (bearing off, no gravity, no imbalance) and a race
+    whose centre oscillates with amplitude A = c_r (1 + excess): the gap |z - c(s)| reaches
+    c_r only near the turning point nu s = pi/2, tangentially as excess -> 0. The search
+    finds the first contact at asin(1/(1 + excess))/nu, on the moving circle; with
+    excess < 0 there is none. Against the fixed bearing there is no contact at all."""
+    from rotortd.params import RotorParams
+    from rotortd.spin_flight import SpinFlight
+
+    p = RotorParams(e_c=0.0, g=0.0)
+    nu = 200.0
+    ring = OscillatingRing(c_r=p.c_r, A=p.c_r * (1.0 + excess), nu=nu)
+    rem = 2.0 / nu  # past the turning point at pi/(2 nu)
+    end = SpinFlight(p, 0.04, 0.0, 0j, 0.0, 0j, 0j, 0.0, 0.0, bearing=ring).run(rem)
+    fixed = SpinFlight(p, 0.04, 0.0, 0j, 0.0, 0j, 0j, 0.0, 0.0).run(rem)
+    assert fixed.event is None and fixed.duration == rem
+    if excess < 0.0:
+        assert end.event is None and end.duration == rem
+        return
+    s_true = math.asin(1.0 / (1.0 + excess)) / nu
+    rdot = p.c_r * nu * math.cos(nu * s_true)  # separation speed at the crossing
+    assert end.event == "contact"
+    # the conditioning limit of an impact time, eps c_r / rdot, with a margin of 64
+    assert abs(end.duration - s_true) <= 64 * 2.2e-16 * (p.c_r / rdot + s_true)
+    c = ring.path(end.duration)[0]
+    assert abs(abs(end.z - c) - p.c_r) <= 4 * 2.2e-16 * p.c_r
+    # the path's bounds are what makes the search rigorous: without them it steps past
+    ring.path_bounds = lambda s, tau: (0.0, 0.0, 0.0, 0.0, 0.0)
+    blind = SpinFlight(p, 0.04, 0.0, 0j, 0.0, 0j, 0j, 0.0, 0.0, bearing=ring).run(rem)
+    assert blind.event is None

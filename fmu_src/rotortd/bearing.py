@@ -12,15 +12,19 @@ A counter-body owns what the contact pair (``rotortd.pair``) needs of it:
   the (n, i n) frame: an impulse (P_n + i P_t) n on it changes the relative normal speed
   and slip at the contact by -W_b (P_n, P_t);
 - ``apply_impulse(P_n, P_t, n)`` (N s): its response to that impulse;
-- ``max_excursion(h)`` (m): a bound on |centre(t) - centre(0)| over the next h seconds,
-  which the contact search adds to its clearance margin;
+- for the contact search: ``moves`` (False for a centre that stays where it is), the path
+  of its centre over the rotor's next flight, ``path(s)`` = (c, c', c'', c''') at s seconds
+  from the flight's start (m, m/s, m/s^2, m/s^3), ``path_bounds(s, tau)`` = bounds of
+  (|c|, |c'|, |c''|, |c'''|, |c''''|) on [s, s + tau], and ``rate`` (1/s), the fastest
+  rate of that path (the search's horizon is a fraction of 1/rate);
 - ``record()``: its state as a plain dict (the core's state record, per component).
 
 ``FixedRigidBearing`` is the chapter's bearing (docs/model.md §1): fixed at the origin,
 rigid, not turning; it takes no share of W and no impulse changes it. A race that turns, a
 housing on a spring-damper and a compliant contact (docs/model.md, the real bearing) are
 further counter-bodies with this interface; ``tests/test_counter_body.py`` proves the
-interface with a free rigid ring.
+interface with a free rigid ring (impacts) and a ring whose centre oscillates (the free-flight
+search, ``spin_flight.SpinFlight(..., bearing=)``, follows the gap to a moving centre).
 """
 
 from __future__ import annotations
@@ -43,7 +47,13 @@ class CounterBody(Protocol):
 
     def apply_impulse(self, P_n: float, P_t: float, n: complex) -> None: ...
 
-    def max_excursion(self, h: float) -> float: ...
+    moves: bool  # the centre moves during a flight (the search then follows its path)
+    rate: float  # fastest rate of the centre's path (1/s); 0 when it does not move
+
+    def path(self, s: float) -> tuple[complex, complex, complex, complex]: ...
+
+    def path_bounds(self, s: float, tau: float
+                    ) -> tuple[float, float, float, float, float]: ...
 
     def record(self) -> dict[str, float]: ...
 
@@ -53,6 +63,8 @@ class FixedRigidBearing:
     at the origin, that neither moves nor turns. SI, inertial."""
 
     __slots__ = ("c_r",)
+    moves = False
+    rate = 0.0
 
     def __init__(self, *, c_r: float) -> None:
         self.c_r = c_r
@@ -74,8 +86,11 @@ class FixedRigidBearing:
     def apply_impulse(self, P_n: float, P_t: float, n: complex) -> None:
         """Fixed and rigid: an impulse changes nothing."""
 
-    def max_excursion(self, h: float) -> float:
-        return 0.0
+    def path(self, s: float) -> tuple[complex, complex, complex, complex]:
+        return (0j, 0j, 0j, 0j)
+
+    def path_bounds(self, s: float, tau: float) -> tuple[float, float, float, float, float]:
+        return (0.0, 0.0, 0.0, 0.0, 0.0)
 
     def record(self) -> dict[str, float]:
         return {}

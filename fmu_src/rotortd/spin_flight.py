@@ -94,6 +94,7 @@ import cmath
 import math
 from operator import mul
 
+from .bearing import CounterBody
 from .events import WORK_MAX, Work, safe_step
 from .params import RotorParams
 from .wall import ContactWorkExceeded, SegmentEnd
@@ -151,7 +152,10 @@ class SpinFlight:
     p: rotor parameters; J: polar inertia about the mass centre (kg m^2, > 0); a: AMB on in
     [0, 1]; F_ext: external force at the geometric centre (N, complex, without gravity);
     T_drive: drive torque (N m). ``force_integration`` uses the Taylor method even when the
-    closed form applies (for tests).
+    closed form applies (for tests). ``bearing``: the counter-body (``rotortd.bearing``);
+    None is the chapter's, fixed at the origin. When its centre moves (``bearing.moves``)
+    the search follows the gap to it, G = |z - c(s)|^2/c_r^2 - 1, with the bounds of its
+    path added to the rotor's (|z - c| <= c_r, |z| <= c_r + |c|).
     """
 
     def __init__(
@@ -167,6 +171,7 @@ class SpinFlight:
         Omega: float,
         *,
         force_integration: bool = False,
+        bearing: CounterBody | None = None,
     ) -> None:
         _check_finite(J, a=a, F_ext=F_ext, T_drive=T_drive, z=z, v=v, psi=psi, Omega=Omega)
         self.p = p
@@ -193,7 +198,9 @@ class SpinFlight:
         self.f0m = self.F0 / self.m - 1j * self.g  # constant part of z_G'' (m/s^2)
         self.f0m_abs = abs(self.f0m)
         self.F0_abs = abs(self.F0)
-        self.w = w = self._rate_scale()
+        self.bearing = bearing
+        self.moving = bearing is not None and bearing.moves
+        self.w = w = max(self._rate_scale(), bearing.rate if self.moving else 0.0)
         self.horizon = HORIZON / w
         self.Om_scale = max(abs(self.Om0), w)
         if self.closed:
@@ -332,11 +339,17 @@ class SpinFlight:
         return self._poly(step, s - step[0])
 
     # ---------------------------------------------------------------- bounds
-    def bounds(self, V0: float, W0: float, tau: float) -> tuple[float, float, float]:
-        """(tau', G3max, G4max): on [s, s + tau'] (tau' <= tau, s, while |z| <= c_r), with
-        |v(s)| = V0 and |Omega(s)| = W0, |G'''| <= G3max and |G''''| <= G4max (1/s^3, 1/s^4)."""
+    def bounds(self, V0: float, W0: float, tau: float, s: float = 0.0
+               ) -> tuple[float, float, float]:
+        """(tau', G3max, G4max): on [s, s + tau'] (tau' <= tau, while |z - c| <= c_r), with
+        |v(s)| = V0 and |Omega(s)| = W0, |G'''| <= G3max and |G''''| <= G4max (1/s^3, 1/s^4).
+        With a moving counter-body its path's bounds on [s, s + tau] are added."""
         ec, J, cr, m = self.ec, self.J, self.cr, self.m
         cA, kA = self.cA, self.kA
+        if self.moving:
+            assert self.bearing is not None
+            Cb, Vb, Ab, Jb, Lb = self.bearing.path_bounds(s, tau)
+            kA = kA * (cr + Cb) / cr  # |z| <= c_r + |c| in the spring's force
         T = abs(self.T)
         if self.closed:
             W = W0 + tau * abs(self.alpha)
@@ -372,6 +385,8 @@ class SpinFlight:
         WD = W * W + D
         L = F2 / m + ec * (2.0 * D * D + 2.0 * W * B2 + B3 + 2.0 * W * (2.0 * W * D + B2)
                            + WD * WD)
+        if self.moving:  # the relative motion z - c
+            V, A, Jm, L = V + Vb, A + Ab, Jm + Jb, L + Lb
         c2 = cr * cr
         G3 = (6.0 * V * A + 2.0 * cr * Jm) / c2
         G4 = (6.0 * A * A + 8.0 * V * Jm + 2.0 * cr * L) / c2
@@ -385,10 +400,12 @@ class SpinFlight:
             raise ValueError(f"rem = {rem!r} s: it must be >= 0")
         work = Work()
         self._limit = limit
-        if self.closed:
+        if self.closed and not self.moving:
             return self._run_closed(rem, limit, work)
-        self._steps.clear()  # every run integrates afresh: its work does not depend on history
-        self._starts.clear()
+        moving, path = self.moving, self.bearing.path if self.moving else None
+        if not self.closed:  # (a closed form searched against a moving counter-body)
+            self._steps.clear()  # every run integrates afresh: work independent of history
+            self._starts.clear()
         self._k = 0
         cr = self.cr
         ic2 = 1.0 / (cr * cr)
@@ -401,12 +418,17 @@ class SpinFlight:
                     work=work.total)
             acc, jerk = self.derivs(z, v, Om, E)
             rho = RHO_INT + RHO_STEP * self._k
-            zc = z.conjugate()
-            g0 = (z * zc).real * ic2 - 1.0
-            g1 = 2.0 * (zc * v).real * ic2
-            g2 = 2.0 * ((v * v.conjugate()).real + (zc * acc).real) * ic2
-            g3 = 2.0 * (3.0 * (v.conjugate() * acc).real + (zc * jerk).real) * ic2
-            az, av = abs(z), abs(v)
+            if moving:  # the motion relative to the counter-body's centre
+                c, c1, c2, c3 = path(s)
+                zr, vr, acc, jerk = z - c, v - c1, acc - c2, jerk - c3
+            else:
+                zr, vr = z, v
+            zc = zr.conjugate()
+            g0 = (zr * zc).real * ic2 - 1.0
+            g1 = 2.0 * (zc * vr).real * ic2
+            g2 = 2.0 * ((vr * vr.conjugate()).real + (zc * acc).real) * ic2
+            g3 = 2.0 * (3.0 * (vr.conjugate() * acc).real + (zc * jerk).real) * ic2
+            az, av = abs(zr), abs(vr)
             M1 = 2.0 * az * av * ic2
             M2 = 2.0 * (av * av + az * abs(acc)) * ic2
             if g0 + 3.0 * rho >= -TOL_G:  # at the wall to resolution and the point error
@@ -420,7 +442,7 @@ class SpinFlight:
                 if kind == "graze":
                     if s >= rem:
                         return self._end(rem, z, v, dpsi, Om, None, work)
-                    s = min(rem, s + self._grace(v, Om, g3, work))
+                    s = min(rem, s + self._grace(v, Om, g3, work, s))
                     z, v, dpsi, Om, E = self.state(s, work)
                     continue
                 # leaving the wall (G' < -its band, which holds the point error)
@@ -433,7 +455,8 @@ class SpinFlight:
             if remaining <= 0.0:
                 return self._end(rem, z, v, dpsi, Om, None, work)
             work.evals += POINT_WORK
-            tau, G3m, G4m = self.bounds(av, abs(Om), min(remaining, self.horizon))
+            tau, G3m, G4m = self.bounds(abs(v) if moving else av, abs(Om),
+                                        min(remaining, self.horizon), s)
             c3 = g3 + 0.25 * tau * G4m + (16.0 * EPS + 3.0 * rho) * G3m + TINY
             u = safe_step(g0, g1, g2, c3, tau, work)
             if u is None:
@@ -544,14 +567,14 @@ class SpinFlight:
             return "touch"
         return "graze"
 
-    def _grace(self, v: complex, Om: float, g3: float, work: Work) -> float:
+    def _grace(self, v: complex, Om: float, g3: float, work: Work, s: float = 0.0) -> float:
         """Step (s) past a tangential point (G within TOL_G of 0, G' within its band, G'' <= 0
         to its band): the larger of (a) the time within which the bound of |G'''| cannot move
         G by TOL_G, and (b) when G''' < 0, the time the cubic term needs to bring G 8 TOL_G
         inside, capped at 2|G'''|/G4max so that the quartic term stays below half of it.
         Within it no excursion beyond the resolution can form."""
         work.evals += POINT_WORK
-        tau, G3m, G4m = self.bounds(abs(v), abs(Om), self.horizon)
+        tau, G3m, G4m = self.bounds(abs(v), abs(Om), self.horizon, s)
         t_bound = (6.0 * TOL_G / max(G3m, 1e-300)) ** (1.0 / 3.0)
         t_cubic = 0.0
         if g3 < 0.0:
@@ -562,9 +585,7 @@ class SpinFlight:
                 work: Work) -> SegmentEnd:
         """Newton on G from a point within TOL_G of the wall moving outward; best point."""
         ic2 = 1.0 / (self.cr * self.cr)
-        zc = z.conjugate()
-        g0 = (z * zc).real * ic2 - 1.0
-        g1 = 2.0 * (zc * v).real * ic2
+        g0, g1 = self._gap(s, z, v, ic2)
         best = (abs(g0), s, z, v, dpsi, Om)
         for _ in range(6):
             if g1 <= 0.0 or abs(g0) <= POLISH_G:
@@ -574,9 +595,7 @@ class SpinFlight:
                 break
             s = s_new
             z, v, dpsi, Om, _ = self.state(s, work)
-            zc = z.conjugate()
-            g0 = (z * zc).real * ic2 - 1.0
-            g1 = 2.0 * (zc * v).real * ic2
+            g0, g1 = self._gap(s, z, v, ic2)
             if abs(g0) < best[0]:
                 best = (abs(g0), s, z, v, dpsi, Om)
         _, s, z, v, dpsi, Om = best
@@ -585,10 +604,25 @@ class SpinFlight:
             return self._end(rem, z, v, dpsi, Om, None, work)
         return self._end(s, z, v, dpsi, Om, "contact", work)
 
+    def _gap(self, s: float, z: complex, v: complex, ic2: float) -> tuple[float, float]:
+        """(G, G') at s of the rotor's (z, v): the gap to the counter-body's circle."""
+        if self.moving:
+            assert self.bearing is not None
+            c, c1, _, _ = self.bearing.path(s)
+            z, v = z - c, v - c1
+        zc = z.conjugate()
+        return (z * zc).real * ic2 - 1.0, 2.0 * (zc * v).real * ic2
+
     def _end(self, s: float, z: complex, v: complex, dpsi: float, Om: float,
              event: str | None, work: Work) -> SegmentEnd:
         """The segment's end at s; a contact's z is projected onto the circle."""
-        if event == "contact":
+        if event == "contact" and self.moving:
+            assert self.bearing is not None
+            c = self.bearing.path(s)[0]
+            r = abs(z - c)
+            if r > 0.0:
+                z = c + (z - c) * (self.cr / r)
+        elif event == "contact":
             r = abs(z)
             if r > 0.0:
                 z = z * (self.cr / r)
