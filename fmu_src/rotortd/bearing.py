@@ -14,7 +14,8 @@ A counter-body owns what the contact pair (``rotortd.pair``) needs of it:
 - ``apply_impulse(P_n, P_t, n)`` (N s): its response to that impulse;
 - ``max_excursion(h)`` (m): a bound on |centre(t) - centre(0)| over the next h seconds,
   which the contact search adds to its clearance margin;
-- ``record()``: its state as a plain dict (the core's state record, per component).
+- ``KIND`` and ``record()``: its kind and its state as a plain dict; the core's state
+  (``rotortd.state``, JSON ``rotortd-state`` 3) holds them as its "bearing" record.
 
 ``FixedRigidBearing`` is the chapter's bearing (docs/model.md §1): fixed at the origin,
 rigid, not turning; it takes no share of W and no impulse changes it. A race that turns, a
@@ -53,6 +54,8 @@ class FixedRigidBearing:
     at the origin, that neither moves nor turns. SI, inertial."""
 
     __slots__ = ("c_r",)
+    KIND = "fixed-rigid"
+    """The "kind" of its state record (``rotortd.state``)."""
 
     def __init__(self, *, c_r: float) -> None:
         self.c_r = c_r
@@ -78,4 +81,5 @@ class FixedRigidBearing:
         return 0.0
 
     def record(self) -> dict[str, float]:
+        """No state of its own: {}."""
         return {}
