@@ -102,7 +102,7 @@ def _state_missing_key() -> tuple[int, int]:
     inst = _running()
     state = inst.slave.getFMUstate()
     doc = json.loads(bytes(inst.slave.serializeFMUstate(state)).decode())
-    del doc["core"]["E_diss"]
+    del doc["core"]["counters"]["E_diss"]
     return _state_case(json.dumps(doc).encode())
 
 

@@ -243,6 +243,33 @@ def sc_state_roundtrip(fmu: str, params: dict, n1: int, n2: int, h: float,
             "modes": sorted({r["mode"] for r in run_a})}
 
 
+def sc_old_state(fmu: str, blob_path: str, params: dict, n1: int, n2: int, h: float,
+                 t_off: float) -> dict[str, Any]:
+    """A serialised state saved by an older build after the recipe (params, n1 steps of h,
+    AMB off at t_off), restored into a fresh instance of this FMU: does it continue as this
+    FMU continues from the same recipe, every output of n2 steps?"""
+    inputs = _amb_switch(t_off)
+    inst = Instance(fmu, "live")
+    inst.init(params)
+    _run(inst, n1, h, inputs)
+    t_saved = inst.t
+    live_doc = json.loads(bytes(inst.slave.serializeFMUstate(inst.slave.getFMUstate())))
+    run_a = _run(inst, n2, h, inputs)
+    with open(blob_path, "rb") as fh:
+        blob = fh.read()
+    old = Instance(fmu, "old")
+    old.init({})
+    restored = old.slave.deSerializeFMUstate(blob)
+    old.slave.setFMUstate(restored)
+    old.slave.freeFMUstate(restored)
+    old.t = t_saved
+    run_c = _run(old, n2, h, inputs)
+    doc = json.loads(blob.decode())
+    return {"same": run_a == run_c, "old_core_version": doc["core"]["version"],
+            "live_core_version": live_doc["core"]["version"],
+            "modes": sorted({r["mode"] for r in run_a}), "messages": MESSAGES}
+
+
 def sc_amb_drop(fmu: str, n: int, h: float, t_off: float, g: float = 9.81) -> dict[str, Any]:
     inst = Instance(fmu)
     inst.init({"g": g})

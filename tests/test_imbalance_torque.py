@@ -353,4 +353,4 @@ def test_switched_off_the_motion_is_the_same_to_the_bit(gamma: float) -> None:
         modes.add(on.mode)
     assert on.n_impacts > 100 and modes >= {0, 1}
     s_on, s_off = on.get_state(), off.get_state()
-    assert s_on.pop("imb_h") != s_off.pop("imb_h") and s_on == s_off
+    assert s_on["step"].pop("imb_h") != s_off["step"].pop("imb_h") and s_on == s_off

@@ -372,7 +372,7 @@ def test_spin_state_runs_without_drop_and_held_rows_have_no_J():
     down = sw.run_job(sw.Job(0, neg, neg, "steady"), short)[0]
     assert up["status"] == down["status"] == "ok" and up["regime"] == "free"
     assert up["Omega_end"] > up["Omega"] > down["Omega_end"]
-    assert math.isnan(up["Omega_mean"]) and json.loads(up["final_state"])["J"] == 0.04
+    assert math.isnan(up["Omega_mean"]) and json.loads(up["final_state"])["rotor"]["J"] == 0.04
     held = _run(0.3, "steady", short)
     assert math.isnan(held["J"]) and math.isnan(held["T_drive"])
     assert held["Omega_end"] == held["Omega"]

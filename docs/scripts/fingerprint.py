@@ -1282,22 +1282,28 @@ def _unit_of(path: str, units: dict[str, float]) -> float | None:
 
 STATE_NAMES: dict[str, str | None] = {
     "schema": None, "version": None,  # the schema's bookkeeping: not compared
-    "params": "params", "t": "t", "t_lo": "t_lo", "z": "z", "v": "v", "psi": "psi",
-    "turns": "turns", "mode": "mode", "theta": "theta", "dtheta": "dtheta", "slip": "slip",
-    "locked": "locked", "on_wall": "on_wall", "n_impacts": "n_impacts", "t_last": "t_last",
-    "v_last": "v_last", "E_diss": "E_diss", "t_contact": "t_contact", "H": "H",
-    "inputs": "inputs", "J": "J",
+    # rotortd-state 2 (flat) -> 3 (one record per component, rotortd.state)
+    "params": "params", "t": "clock.t", "t_lo": "clock.t_lo", "z": "rotor.z",
+    "v": "rotor.v", "psi": "rotor.psi", "turns": "rotor.turns", "mode": "contact.mode",
+    "theta": "contact.theta", "dtheta": "contact.dtheta", "slip": "contact.slip",
+    "locked": "contact.locked", "on_wall": "contact.on_wall",
+    "n_impacts": "counters.n_impacts", "t_last": "counters.t_last",
+    "v_last": "counters.v_last", "E_diss": "counters.E_diss",
+    "t_contact": "contact.t_contact", "H": "contact.slide_step",
+    "inputs.0": "rotor.Omega", "inputs.1": "step.F_ext.0", "inputs.2": "step.F_ext.1",
+    "inputs.3": "step.amb_on", "J": "rotor.J",
     "imb_h": None,  # a cache's choice between two roundings (rotortd-state 2)
+    "step.imb_h": None,  # ... and its place in rotortd-state 3
 }
-"""The map of the core's state (``get_state()`` JSON, rotortd-state 2) from the base's names
-to the head's: the ONE place a new state layout is declared. Keys are dotted paths of the
-base's state (a key covers everything below it; the longest key that matches a leaf wins),
-values the head's path for the same quantity, None for a leaf not compared. Today every
-name maps to itself. A new layout adds entries, e.g. per-component records with an
-index-level split of the inputs:
-
-    "z": "rotor.z", "inputs.0": "rotor.Omega", "inputs.1": "inputs.F_ext", "theta":
-    "contact.theta",
+"""The map of the core's state (``get_state()`` JSON) from the base's names to the head's:
+the ONE place a new state layout is declared. Keys are dotted paths of the base's state (a
+key covers everything below it; the longest key that matches a leaf wins), values the
+head's path for the same quantity, None for a leaf not compared. Today it maps the flat
+rotortd-state 2 (a base before the layout by component) onto rotortd-state 3, with an
+index-level split of the inputs (``"inputs.0": "rotor.Omega"``); against a base that is
+already version 3, the head's own paths are not keys of the map and keep their names
+(``"step.imb_h"`` is a key only so that the cache is not compared and not listed as added);
+the head's ``bearing.kind`` is listed as added against a version 2 base.
 
 (a value must keep its representation: a complex as [re, im] maps leaf by leaf, "z.0":
 "rotor.z.re"). Leaves the base has and the head lacks (after the map) are differences;
@@ -1369,7 +1375,7 @@ def compare_final(v: Verdict, a: Any, b: Any, units: dict[str, float], what: str
 
 def _covered(head_path: str, names: dict[str, str | None]) -> bool:
     """A head leaf under a path the map leaves out (None) on both sides (schema, caches)."""
-    return rename(head_path, names) is None and head_path.split(".")[0] in names
+    return rename(head_path, names) is None
 
 
 def compare_job(job: tuple[str, str, str], ra: dict[str, Any], rb: dict[str, Any],

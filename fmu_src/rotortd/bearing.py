@@ -17,7 +17,8 @@ A counter-body owns what the contact pair (``rotortd.pair``) needs of it:
   from the flight's start (m, m/s, m/s^2, m/s^3), ``path_bounds(s, tau)`` = bounds of
   (|c|, |c'|, |c''|, |c'''|, |c''''|) on [s, s + tau], and ``rate`` (1/s), the fastest
   rate of that path (the search's horizon is a fraction of 1/rate);
-- ``record()``: its state as a plain dict (the core's state record, per component).
+- ``KIND`` and ``record()``: its kind and its state as a plain dict; the core's state
+  (``rotortd.state``, JSON ``rotortd-state`` 3) holds them as its "bearing" record.
 
 ``FixedRigidBearing`` is the chapter's bearing (docs/model.md §1): fixed at the origin,
 rigid, not turning; it takes no share of W and no impulse changes it. A race that turns, a
@@ -65,6 +66,8 @@ class FixedRigidBearing:
     __slots__ = ("c_r",)
     moves = False
     rate = 0.0
+    KIND = "fixed-rigid"
+    """The "kind" of its state record (``rotortd.state``)."""
 
     def __init__(self, *, c_r: float) -> None:
         self.c_r = c_r
@@ -93,4 +96,5 @@ class FixedRigidBearing:
         return (0.0, 0.0, 0.0, 0.0, 0.0)
 
     def record(self) -> dict[str, float]:
+        """No state of its own: {}."""
         return {}

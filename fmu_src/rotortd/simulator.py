@@ -45,7 +45,7 @@ from .report import (
 )
 from .rub import RubEquilibrium
 from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
-from .state import CoreState
+from .state import CoreState, fixed_bearing_record
 from .wall import ContactWorkExceeded, WallForces, phase_integral
 
 __all__ = [
@@ -468,7 +468,8 @@ class TouchdownCore(FlightSteps, ContactSteps):
             n_impacts=self._n_impacts, t_last=self._t_last, v_last=self._v_last,
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
             imb_h=(self._imb_seen_h, self._imb_free_h),
-            inputs=self._inputs,
+            Omega=self._inputs[0], F_ext=self._inputs[1], amb_on=self._inputs[2],
+            bearing=fixed_bearing_record(),
         )
 
     def get_state(self) -> dict:
@@ -486,6 +487,10 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 f"{'a state (J set)' if cs.J is not None else 'held (no J)'}; this core's "
                 f"spin is {'a state' if self.SPIN_STATE else 'held'}: restore it into a "
                 f"{'SpinCore' if cs.J is not None else 'TouchdownCore'} (rotortd.restore_core)")
+        if dict(cs.bearing) != fixed_bearing_record():
+            raise ParameterError(
+                f"the state's bearing record {dict(cs.bearing)!r} is not of this core's "
+                f"bearing {fixed_bearing_record()!r} (bearing.FixedRigidBearing)")
         self._p = cs.params
         self._t, self._t_lo = cs.t, cs.t_lo
         self._z, self._v = cs.z, cs.v
