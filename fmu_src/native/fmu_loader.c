@@ -23,9 +23,12 @@
  *   closed; a library in use is never unloaded. Its installation prefix becomes Python's
  *   home (Py_SetPythonHome, unless PYTHONHOME is set), so that it starts on its own
  *   standard library even when PATH holds another Python of the same version.
- * - Then PythonFMU's binary is opened (RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND: its fmi2*
- *   calls bind to its own definitions even if a host put this loader in the global scope)
- *   and every fmi2 function is forwarded to it unchanged.
+ * - Then PythonFMU's binary is opened (RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE) and every
+ *   fmi2 function is forwarded to it unchanged. Not RTLD_DEEPBIND: its Py* symbols come
+ *   from the global scope either way, and deep binding would give it libc's malloc and
+ *   libstdc++'s operator new where a host replaces them. PythonFMU's binary never calls
+ *   its own fmi2* entry points, and if a host put this loader in the global scope such a
+ *   call would only take one more hop through the forwarder below, never loop.
  * - If no usable libpython is found, fmi2Instantiate returns NULL after one message, through
  *   the host's logger and on stderr, that lists what was tried and names ROTORTD_LIBPYTHON.
  *
@@ -352,7 +355,7 @@ static int open_sibling(char *report) {
     size_t n = strlen(self);
     if (n > 3 && strcmp(self + n - 3, ".so") == 0) self[n - 3] = 0;
     snprintf(path, sizeof path, "%s%s", self, SIBLING_SUFFIX);
-    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND);
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
     if (!h) {
         const char *err = dlerror();
         append(report, "cannot open PythonFMU's binary %s: %s", path, err ? err : "?");
