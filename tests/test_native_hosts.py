@@ -247,3 +247,23 @@ def test_ecos_cli_without_preload_equals_fmpy(fmu_dir: Path, tmp_path: Path) -> 
             # %f: six decimals, then the double's own rounding of the printed value
             assert abs(row[i] - ref[1 + j]) <= 5.000001e-7 + 1e-15 * abs(ref[1 + j]), (
                 columns[i], row[1], row[i], ref[1 + j])
+
+
+def test_python_host_loads_no_libpython(fmu_dir: Path) -> None:
+    """In a Python host (FMPy) the loader finds Python already there and loads nothing,
+    even with ROTORTD_LIBPYTHON naming another CPython's library: that library is never
+    mapped, and the outputs are the same bits as without the variable."""
+    others = [p for p in _pythons() if f"3.{sys.version_info.minor}." not in str(p)]
+    if not others:
+        pytest.skip("no other CPython 3.10+ library on this machine")
+    fmu = fmu_dir / "RotorTouchdown.fmu"
+    name = others[0].name
+    code = FMPY_SCRIPT + (f"\nprint('MAPPED' if any({name!r} in line for line in "
+                          "open('/proc/self/maps')) else 'CLEAN')")
+    env = dict(os.environ, ROTORTD_LIBPYTHON=str(others[0]))
+    proc = subprocess.run([sys.executable, "-c", code, str(fmu), repr(STEP), "50", "1"],
+                          env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    *rows, verdict = proc.stdout.splitlines()
+    assert verdict == "CLEAN"
+    assert "\n".join(rows) + "\n" == _run_fmpy(fmu, [1], [], nsteps=50)
