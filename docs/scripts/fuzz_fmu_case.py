@@ -392,9 +392,11 @@ def run_cases(unzipdir: str, specs: list[dict[str, Any]], step_limit: float,
 
     def on_hang(elapsed: float) -> None:
         run = current[0]
-        run.res.abandoned = {**run.current, "wall": elapsed}
+        cpu = time.process_time() - watchdog.cpu_started
+        run.res.abandoned = {**run.current, "wall": elapsed, "cpu": cpu}
         run.res.wall = time.perf_counter() - run.t_start
         run.res.max_step_wall = max(run.res.max_step_wall, elapsed)
+        run.res.max_step_cpu = max(run.res.max_step_cpu, cpu)
         if run.res.slow_step is None:
             run.res.slow_step = {**run.current, "wall": elapsed}
         emit("CASE " + run.res.as_json())
