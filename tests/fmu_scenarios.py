@@ -140,6 +140,18 @@ def _run(inst: Instance, n: int, h: float, inputs: Callable[[float], dict] | Non
     return rows
 
 
+def _run_restored(fmu: str, name: str, blob: bytes, t_saved: float, n: int, h: float,
+                  inputs: Callable[[float], dict] | None) -> list[dict[str, Any]]:
+    """A new instance restored from a serialized FMU state at t_saved, run n steps of h."""
+    inst = Instance(fmu, name)
+    inst.init({})
+    restored = inst.slave.deSerializeFMUstate(blob)
+    inst.slave.setFMUstate(restored)
+    inst.slave.freeFMUstate(restored)
+    inst.t = t_saved
+    return _run(inst, n, h, inputs)
+
+
 def _amb_switch(t_off: float) -> Callable[[float], dict]:
     return lambda t: {"amb_on": 0.0 if t >= t_off - 1e-12 else 1.0}
 
@@ -226,13 +238,7 @@ def sc_state_roundtrip(fmu: str, params: dict, n1: int, n2: int, h: float,
     inst.t = t_saved
     run_b = _run(inst, n2, h, inputs)
     inst.slave.freeFMUstate(state)
-    fresh = Instance(fmu, "fresh")
-    fresh.init({})
-    restored = fresh.slave.deSerializeFMUstate(blob)
-    fresh.slave.setFMUstate(restored)
-    fresh.slave.freeFMUstate(restored)
-    fresh.t = t_saved
-    run_c = _run(fresh, n2, h, inputs)
+    run_c = _run_restored(fmu, "fresh", blob, t_saved, n2, h, inputs)
     doc = json.loads(blob.decode())
     return {"same_get_set": run_a == run_b, "same_serialized": run_a == run_c,
             "n_impacts": [run_a[-1]["n_impacts"], run_c[-1]["n_impacts"]],
@@ -257,13 +263,7 @@ def sc_old_state(fmu: str, blob_path: str, params: dict, n1: int, n2: int, h: fl
     run_a = _run(inst, n2, h, inputs)
     with open(blob_path, "rb") as fh:
         blob = fh.read()
-    old = Instance(fmu, "old")
-    old.init({})
-    restored = old.slave.deSerializeFMUstate(blob)
-    old.slave.setFMUstate(restored)
-    old.slave.freeFMUstate(restored)
-    old.t = t_saved
-    run_c = _run(old, n2, h, inputs)
+    run_c = _run_restored(fmu, "old", blob, t_saved, n2, h, inputs)
     doc = json.loads(blob.decode())
     return {"same": run_a == run_c, "old_core_version": doc["core"]["version"],
             "live_core_version": live_doc["core"]["version"],
