@@ -197,7 +197,7 @@ def test_planted_bad_citations_are_caught() -> None:
     text = ("See docs/model.md §99, `fmu_src/rotortd/no_such.py`, `rotortd.scaled.nope`,\n"
             "`rotortd.no_module`, docs/nowhere.md §1 and ../shared/MODEL.md §6.\n"
             "Good: docs/model.md §1, `fmu_src/rotortd/scaled.py`, `rotortd.scaled.to_scaled`,"
-            " `rotortd.simulator.TouchdownCore.step`.")
+            " `rotortd.step.simulator.TouchdownCore.step`.")
     cites = find_citations("planted.md", 1, text)
     verdicts = {c.text: bool(check(c)) for c in cites}
     assert verdicts == {
@@ -206,5 +206,5 @@ def test_planted_bad_citations_are_caught() -> None:
         "rotortd.scaled.nope": True, "rotortd.no_module": True, "docs/nowhere.md §1": True,
         "../shared": True, "MODEL.md": True,
         "docs/model.md §1": False, "fmu_src/rotortd/scaled.py": False,
-        "rotortd.scaled.to_scaled": False, "rotortd.simulator.TouchdownCore.step": False,
+        "rotortd.scaled.to_scaled": False, "rotortd.step.simulator.TouchdownCore.step": False,
     }, verdicts

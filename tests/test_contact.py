@@ -16,11 +16,12 @@ from rotortd import (
     TouchdownCore,
     WallForces,
     forward_rub_equilibria,
-    gbs,
     work_cap,
 )
-from rotortd.contact import LinearRub, QuadraticRub, Sliding, _monomial_integrals
-from rotortd.contact_step import closed_form_rub
+from rotortd.segments import gbs
+from rotortd.segments.rub import LinearRub, QuadraticRub, _monomial_integrals
+from rotortd.segments.sliding import Sliding
+from rotortd.step.contact_step import closed_form_rub
 
 from tests.reference.direct import direct_simulate
 from tests.reference.mp_reference import (
@@ -446,7 +447,7 @@ def test_quadratic_rub_algebra(a1: float, b1: float) -> None:
     c1 x1^2 + c3 y1^2 (under-, barely, critically and over-damped rub modes) satisfies
     r = p M and r M = -a1 p - b1 r + c, and _monomial_integrals solves (M + iW) K = d.
     At the resonance 9 a1 = 2 b1^2 (one eigenvalue twice the other) it is refused."""
-    from rotortd.contact import RubEquilibrium
+    from rotortd.segments.rub import RubEquilibrium
 
     eig = tuple(cmath.sqrt(b1 * b1 / 4 - a1) * sg - b1 / 2 for sg in (1, -1))
     eq = RubEquilibrium(0.3, 5e4, True, eig, a1, b1, 2.3e3)

@@ -8,7 +8,7 @@ import random
 
 import pytest
 from rotortd import RotorParams, TouchdownCore, work_cap
-from rotortd.events import (
+from rotortd.contact.search import (
     EPS,
     HORIZON,
     ContactLocator,
@@ -18,7 +18,7 @@ from rotortd.events import (
     g3_slack,
     safe_step,
 )
-from rotortd.flight import FlightModel
+from rotortd.segments.flight import FlightModel
 
 from tests.reference.mp_reference import mp_first_impact
 

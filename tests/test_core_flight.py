@@ -12,7 +12,7 @@ import math
 import mpmath
 import pytest
 from rotortd import RotorParams, TouchdownCore
-from rotortd.flight import FlightModel
+from rotortd.segments.flight import FlightModel
 
 from tests.reference.mp_reference import mp_flight
 

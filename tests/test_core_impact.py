@@ -5,7 +5,7 @@ from __future__ import annotations
 import cmath
 
 import pytest
-from rotortd.impact import reset
+from rotortd.contact.impact import reset
 
 M, R, W = 50.0, 0.04, 184.2
 

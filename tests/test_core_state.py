@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from rotortd import ParameterError, RotorParams, SpinCore, TouchdownCore, restore_core
-from rotortd.state import CoreState
+from rotortd.step.state import CoreState
 
 W0 = 184.2
 F = 3.0 - 4.0j  # N

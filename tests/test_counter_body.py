@@ -1,8 +1,8 @@
 """The contact pair's interface carries a counter-body that moves and turns (issue 23, item 2).
 
 A test-only counter-body, ``FreeRing``: a free rigid ring (mass m_b, polar inertia J_b about
-its centre, bore R_b = R + c_r, no support), implementing ``rotortd.bearing.CounterBody``.
-Through ``rotortd.pair.ContactPair`` with the spinning rigid rotor, frictionless and
+its centre, bore R_b = R + c_r, no support), implementing ``rotortd.bodies.bearing.CounterBody``.
+Through ``rotortd.contact.pair.ContactPair`` with the spinning rigid rotor, frictionless and
 frictional impacts at random states
 
 * use W = the rotor's W + diag(1/m_b, 1/m_b + R_b^2/J_b);
@@ -12,7 +12,7 @@ frictional impacts at random states
 * never create energy.
 
 A second test-only counter-body, ``OscillatingRing``, moves its centre on a known path: the
-free-flight search (``rotortd.spin_flight.SpinFlight`` with ``bearing=``) finds a grazing
+free-flight search (``rotortd.segments.spin_flight.SpinFlight`` with ``bearing=``) finds a grazing
 contact with it, at the analytic time, and only because it adds the path's bounds.
 
 And the chapter's case: the held-speed rotor (``RigidRotor.held``, J = inf) on the fixed
@@ -27,10 +27,10 @@ import math
 import random
 
 import pytest
-from rotortd.bearing import FixedRigidBearing
-from rotortd.impact import reset
-from rotortd.pair import ContactPair
-from rotortd.rigid import RigidRotor
+from rotortd.bodies.bearing import FixedRigidBearing
+from rotortd.bodies.rotor import RigidRotor
+from rotortd.contact.impact import reset
+from rotortd.contact.pair import ContactPair
 
 M, R, C_R = 50.0, 0.04, 0.7e-3
 
@@ -181,7 +181,7 @@ def test_search_finds_a_grazing_contact_with_a_moving_circle(excess: float) -> N
     finds the first contact at asin(1/(1 + excess))/nu, on the moving circle; with
     excess < 0 there is none. Against the fixed bearing there is no contact at all."""
     from rotortd.params import RotorParams
-    from rotortd.spin_flight import SpinFlight
+    from rotortd.segments.spin_flight import SpinFlight
 
     p = RotorParams(e_c=0.0, g=0.0)
     nu = 200.0

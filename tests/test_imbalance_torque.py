@@ -33,8 +33,8 @@ from rotortd import (
     SpinCore,
     TouchdownCore,
 )
-from rotortd.rub import LinearRub, LockedRub, QuadraticRub
-from rotortd.sliding import Sliding
+from rotortd.segments.rub import LinearRub, LockedRub, QuadraticRub
+from rotortd.segments.sliding import Sliding
 from scipy.integrate import solve_ivp
 
 TOL = 1e-9

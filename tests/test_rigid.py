@@ -1,4 +1,4 @@
-"""The impact law with the spin as a state (rotortd.rigid): checked on the rigid body itself.
+"""The impact law with the spin as a state (rotortd.bodies.rotor): checked on the rigid body itself.
 
 Each random impact is applied to a rigid body (geometric centre velocity v, spin Omega,
 imbalance phasor E); the outcome is checked through the body's own kinematics and kinetic
@@ -12,9 +12,9 @@ import math
 import random
 
 import pytest
-from rotortd.impact import reset
+from rotortd.bodies.rotor import Delassus, check_well_posed, spin_impact
+from rotortd.contact.impact import reset
 from rotortd.params import CrossParameterError, RotorParams
-from rotortd.rigid import Delassus, check_well_posed, spin_impact
 
 M, R = 50.0, 0.04
 

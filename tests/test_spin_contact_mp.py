@@ -1,4 +1,4 @@
-"""The spin-as-a-state contact segments (``rotortd.spin_contact.SpinContact``, docs/model.md §8,
+"""The spin-as-a-state contact segments (``rotortd.segments.spin_contact.SpinContact``,
 docs/model.md §8) against the 40-digit Taylor integration ``tests.reference.spin_mp.mp_contact``
 (its own coding of the equations; no shared code).
 
@@ -21,9 +21,9 @@ from typing import Any
 
 import mpmath
 import pytest
+from rotortd.contact.wall import SegmentEnd
 from rotortd.params import RotorParams
-from rotortd.spin_contact import HeldInputs, SpinContact
-from rotortd.wall import SegmentEnd
+from rotortd.segments.spin_contact import HeldInputs, SpinContact
 
 from tests.reference.spin_mp import mp_contact
 

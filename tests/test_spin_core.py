@@ -13,7 +13,7 @@ import math
 
 import pytest
 from rotortd import MODE_ROLLING, MODE_SLIDING, STATUS_OK, CrossParameterError, RotorParams
-from rotortd.spin_core import SpinCore, restore_core
+from rotortd.step.spin_core import SpinCore, restore_core
 
 CHAPTER_G = RotorParams(g=9.81)
 J_HALF = 0.5 * CHAPTER_G.m * CHAPTER_G.R ** 2  # 0.04 kg m^2

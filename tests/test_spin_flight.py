@@ -1,4 +1,4 @@
-"""Free flight with the spin as a state (rotortd.spin_flight) against 40-digit references.
+"""Free flight with the spin as a state (rotortd.segments.spin_flight) against 40-digit references.
 
 References (mpmath, 40 digits, here only): the closed form of the drop scene evaluated in
 mpmath, and a Taylor integration of order 30 written in the model's own form (m z'' with
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import mpmath as mp
 import pytest
+from rotortd.contact.wall import ContactWorkExceeded
 from rotortd.params import RotorParams
-from rotortd.spin_flight import POINT_WORK, SpinFlight
-from rotortd.wall import ContactWorkExceeded
+from rotortd.segments.spin_flight import POINT_WORK, SpinFlight
 
 mp.mp.dps = 40
 BIG = 10**7  # work limit that never binds here

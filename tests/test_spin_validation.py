@@ -16,7 +16,7 @@ import random
 import numpy as np
 import pytest
 from rotortd import MODE_ROLLING, RotorParams, SpinCore, TouchdownCore
-from rotortd.rigid import Delassus, spin_impact
+from rotortd.bodies.rotor import Delassus, spin_impact
 
 from tests.reference.spin_reference import impact_law, simulate, steady_whirl_start
 from tests.reference.spin_scenes import CHAPTER_G, OMEGA0

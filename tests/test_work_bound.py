@@ -11,7 +11,7 @@ import math
 
 import pytest
 from rotortd import STATUS_OK, STATUS_WORK_CAP, WORK_MAX, RotorParams, SpinCore, TouchdownCore
-from rotortd.events import WORK_OVERSHOOT
+from rotortd.contact.search import WORK_OVERSHOOT
 
 BASE = RotorParams()  # the FMU's defaults: m = 50 kg, c_r = 0.7 mm, Omega = 184.2 rad/s
 W0 = 184.2

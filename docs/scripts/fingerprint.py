@@ -1282,7 +1282,7 @@ def _unit_of(path: str, units: dict[str, float]) -> float | None:
 
 STATE_NAMES: dict[str, str | None] = {
     "schema": None, "version": None,  # the schema's bookkeeping: not compared
-    # rotortd-state 2 (flat) -> 3 (one record per component, rotortd.state)
+    # rotortd-state 2 (flat) -> 3 (one record per component, rotortd.step.state)
     "params": "params", "t": "clock.t", "t_lo": "clock.t_lo", "z": "rotor.z",
     "v": "rotor.v", "psi": "rotor.psi", "turns": "rotor.turns", "mode": "contact.mode",
     "theta": "contact.theta", "dtheta": "contact.dtheta", "slip": "contact.slip",

@@ -6,11 +6,12 @@ The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``To
 (the spin held over each step) and ``SpinCore`` (the spin as a state, docs/model.md §8).
 """
 
-from .contact import RubEquilibrium, WallForces, forward_rub_equilibria
-from .impact import Impact
+from .contact.impact import Impact
+from .contact.wall import WallForces
 from .limits import LIMITS, CrossParameterError, Limit
 from .params import TUNABLE, InputError, ParameterError, RotorParams, ScaledParams
-from .simulator import (
+from .segments.rub import RubEquilibrium, forward_rub_equilibria
+from .step.simulator import (
     MODE_FREE,
     MODE_ROLLING,
     MODE_SLIDING,
@@ -22,7 +23,7 @@ from .simulator import (
     TouchdownCore,
     work_cap,
 )
-from .spin_core import SpinCore, restore_core
+from .step.spin_core import SpinCore, restore_core
 
 __all__ = [
     "LIMITS",

@@ -56,7 +56,7 @@ def wrap_angle(x: float) -> float:
     The reduction is by the true 2 pi, so a result can lie a rounding or so outside the
     doubles -pi, pi. An angle in [-pi, pi) is returned unchanged (bit for bit), except in
     the last few ulp below pi, where (x + pi)/(2 pi) rounds to 1. Same bits as
-    ``rotortd.contact.wrap_angle`` and ``TouchdownCore._advance_psi``'s reduction.
+    ``TouchdownCore._advance_psi``'s reduction.
     """
     k = math.floor((x + math.pi) / (2.0 * math.pi))
     if k == 0:

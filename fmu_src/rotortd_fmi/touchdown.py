@@ -40,7 +40,7 @@ STATE_SCHEMA = "rotortd-fmu-state"
 STATE_VERSION = 2
 """Version 2: the spin state (integrate_spin) is in the core's state; version 1 states of
 a held-speed instance still load, those of the former sub-stepped spin coupler do not. The
-core's state under "core" carries its own schema and version (``rotortd.state``: written
+core's state under "core" carries its own schema and version (``rotortd.step.state``: written
 as rotortd-state 3, by component; FMU states embedding rotortd-state 1 or 2 still load)."""
 
 VARIABLE_META = meta(tv.TABLE)  # read by build.py

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 from rotortd import ScaledParams
-from rotortd.events import Contact, ContactLocator, Work
-from rotortd.flight import FlightModel
-from rotortd.impact import reset
+from rotortd.contact.impact import reset
+from rotortd.contact.search import Contact, ContactLocator, Work
 from rotortd.scaled import CHAPTER_OMEGA as OMEGA
 from rotortd.scaled import si_params, wrap_angle
+from rotortd.segments.flight import FlightModel
 
 from rotortd_tools.cycles.flow import ScaledFlow, real_jac, to_real
 

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 from rotortd import ParameterError, RotorParams, ScaledParams
-from rotortd.rigid import check_well_posed
+from rotortd.bodies.rotor import check_well_posed
 from rotortd.scaled import CHAPTER_OMEGA, chapter_params, si_params
 
 SCALED_NAMES = ("gamma", "omega", "rho", "phi", "mu", "d", "R_over_cr")

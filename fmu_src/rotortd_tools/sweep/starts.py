@@ -26,7 +26,7 @@ from dataclasses import replace
 
 from rotortd import ParameterError, RotorParams, ScaledParams, SpinCore, TouchdownCore
 from rotortd.scaled import regular_equilibrium
-from rotortd.state import CoreState
+from rotortd.step.state import CoreState
 
 from rotortd_tools.sweep.spec import (
     CONTINUATION,

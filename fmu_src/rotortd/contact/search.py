@@ -37,7 +37,7 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from .flight import FlightModel, Modes
+from ..segments.flight import FlightModel, Modes
 
 EPS = 2.220446049250313e-16
 TOL_G_ULPS = 64.0

@@ -18,12 +18,15 @@ from __future__ import annotations
 import cmath
 import math
 
+from ..contact.search import SEGMENT_WORK, WORK_MAX
+from ..contact.wall import ContactWorkExceeded, WallForces, phase_integral
+from ..limits import CrossParameterError, start_position
+from ..params import InputError, ParameterError, RotorParams, check_finite, check_range
+from ..scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
+from ..segments.flight import FlightModel
+from ..segments.rub import RubEquilibrium
 from .contact_step import LOCK_TOL, RUB_RETRY, ContactSteps
-from .events import SEGMENT_WORK, WORK_MAX
-from .flight import FlightModel
 from .flight_step import ETA_HEIGHT, ETA_TIME, N_CASCADE, FlightSteps
-from .limits import CrossParameterError, start_position
-from .params import InputError, ParameterError, RotorParams, check_finite, check_range
 from .report import (
     _MODE_NAMES,
     _PROVED_FREE,
@@ -43,10 +46,7 @@ from .report import (
     stop_at_work_bound,
     work_cap,
 )
-from .rub import RubEquilibrium
-from .scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 from .state import CoreState, fixed_bearing_record
-from .wall import ContactWorkExceeded, WallForces, phase_integral
 
 __all__ = [
     "ETA_HEIGHT", "ETA_TIME", "LOCK_TOL", "MODE_FREE", "MODE_ROLLING", "MODE_SLIDING",

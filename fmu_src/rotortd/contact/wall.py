@@ -1,6 +1,6 @@
 """The wall's forces and what every contact segment shares (docs/model.md §5).
 
-Frame and units: inertial, SI; forces per unit m c_r (1/s^2), as in ``rotortd.contact``'s
+Frame and units: inertial, SI; forces per unit m c_r (1/s^2), as in ``rotortd.segments``'s
 docstring. WallForces: the contact-free forces at the wall under held inputs.
 ContactTally: a segment's contact integrals. SegmentEnd: what every segment's
 ``run(rem, limit)`` returns, flight or contact, the spin held or a state.
@@ -12,9 +12,9 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from .divdiff import dd2
-from .events import G2_FLOOR
-from .params import RotorParams
+from ..params import RotorParams
+from ..segments.divdiff import dd2
+from .search import G2_FLOOR
 
 
 class ContactWorkExceeded(RuntimeError):

@@ -1,7 +1,7 @@
 """Sustained contact: the contact segments of TouchdownCore.
 
 Frame and units: inertial, SI; the contact state is (theta, theta') on the clearance
-circle (``rotortd.contact``). A mixin of ``simulator.TouchdownCore``: each contact segment
+circle (``rotortd.segments``). A mixin of ``simulator.TouchdownCore``: each contact segment
 is chosen from the state (lift-off, rolling, a rub in closed form, sliding), advanced
 through the one segment interface ``run(rem, limit) -> SegmentEnd`` and its end applied.
 """
@@ -11,9 +11,10 @@ from __future__ import annotations
 import cmath
 import math
 
-from .report import MODE_FREE, MODE_ROLLING, MODE_SLIDING, StepContext, StepReport
-from .rolling import Rolling
-from .rub import (
+from ..contact.wall import SegmentEnd, WallForces
+from ..scaled import wrap_angle
+from ..segments.rolling import Rolling
+from ..segments.rub import (
     QUAD_TOL,
     LinearRub,
     LockedRub,
@@ -22,9 +23,8 @@ from .rub import (
     forward_rub_equilibria,
     rub_deviation,
 )
-from .scaled import wrap_angle
-from .sliding import Sliding
-from .wall import SegmentEnd, WallForces
+from ..segments.sliding import Sliding
+from .report import MODE_FREE, MODE_ROLLING, MODE_SLIDING, StepContext, StepReport
 
 LOCK_TOL = 1e-14
 """A sliding state on the linearised rub (contact.LinearRub) whose snap_error is at most

@@ -35,10 +35,10 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..contact.search import WORK_MAX
+from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
+from ..params import RotorParams
 from . import gbs
-from .events import WORK_MAX
-from .params import RotorParams
-from .wall import ContactTally, ContactWorkExceeded, SegmentEnd
 
 RTOL = 1e-13
 """Relative tolerance per extrapolated step, every component."""

@@ -1,4 +1,7 @@
-"""Sustained contact on the clearance circle: sliding and rolling (docs/model.md §5).
+"""The segments: the motion between events, each in closed form or integrated with a
+stated error.
+
+Held spin, sustained contact on the clearance circle: sliding and rolling (docs/model.md §5).
 
 Frame and units: inertial, SI. On the circle z = c_r e^{i theta}; the state is the polar
 angle theta (rad) and the whirl rate theta' (rad/s). Forces are written per unit m c_r
@@ -23,36 +26,8 @@ kappa = a k/m. The slip of the contact point is v_rel = c_r (wr + theta'), wr = 
   motion is in closed form, to first (LinearRub) or second order (QuadraticRub) in the
   deviation, with the dropped terms bounded; on it, a rigid rotation.
 
-The modules, one job each: ``wall`` (WallForces, ContactTally, SegmentEnd: the segment
-interface), ``sliding``, ``rolling``, ``rub`` (LinearRub, QuadraticRub, LockedRub). This
-module gathers their public names.
+The modules, one job each: ``rotortd.contact.wall`` (WallForces, ContactTally,
+SegmentEnd: the segment interface), ``sliding``, ``rolling``, ``rub`` (LinearRub,
+QuadraticRub, LockedRub); with the spin as a state, ``spin_flight`` and ``spin_contact``;
+the exact flight ``flight`` and the integrators ``gbs`` and ``divdiff``.
 """
-
-from .rolling import MAX_ROOT_ITERS, Rolling, TrigSum
-from .rub import (
-    LINEAR_BUDGET,
-    LINEAR_TOL,
-    QUAD_TOL,
-    LinearRub,
-    LockedRub,
-    QuadraticRub,
-    RubEquilibrium,
-    _monomial_integrals,
-    _quadratic_drop,
-    _rub_propagator,
-    _RubStep,
-    forward_rub_equilibria,
-    rub_deviation,
-)
-from .scaled import wrap_angle
-from .sliding import GBS_STEP_WORK, K_MIN, NU_MIN, RTOL, SCALE_FLOOR, Sliding
-from .wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces, phase_integral
-
-__all__ = [
-    "GBS_STEP_WORK", "K_MIN", "LINEAR_BUDGET", "LINEAR_TOL", "MAX_ROOT_ITERS", "NU_MIN",
-    "QUAD_TOL", "RTOL", "SCALE_FLOOR", "ContactTally", "ContactWorkExceeded", "LinearRub",
-    "LockedRub", "QuadraticRub", "Rolling", "RubEquilibrium", "SegmentEnd", "Sliding",
-    "TrigSum", "WallForces", "_RubStep", "_monomial_integrals", "_quadratic_drop",
-    "_rub_propagator", "forward_rub_equilibria", "phase_integral", "rub_deviation",
-    "wrap_angle",
-]

@@ -11,9 +11,9 @@ from collections import namedtuple
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from .events import WORK_MAX, Work
-from .impact import Impact
-from .wall import ContactTally
+from ..contact.impact import Impact
+from ..contact.search import WORK_MAX, Work
+from ..contact.wall import ContactTally
 
 MODE_FREE, MODE_SLIDING, MODE_ROLLING = 0, 1, 2
 STATUS_OK, STATUS_WORK_CAP = 0, 1

@@ -2,7 +2,7 @@
 
 theta' = -wr is constant and Ft = Gt (static friction); theta, Gn and Gt are sums of two
 rotating phasors, so the motion, its exits (lift-off, friction cone) and its integrals are
-closed form (frame and units as in ``rotortd.contact``).
+closed form (frame and units as in ``rotortd.segments``).
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from .events import WORK_MAX
-from .scaled import wrap_angle
-from .wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces, phase_integral
+from ..contact.search import WORK_MAX
+from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces, phase_integral
+from ..scaled import wrap_angle
 
 MAX_ROOT_ITERS = 200
 """Cap on conservative-advancement iterations for one rolling exit search."""

@@ -3,7 +3,7 @@
 With q0 = 0 the sliding system is autonomous in the co-rotating frame and has equilibria
 theta' = Omega (forward_rub_equilibria). Near a stable one the motion is in closed form, to
 first (LinearRub) or second order (QuadraticRub) in the deviation, with the dropped terms
-bounded; on it, a rigid rotation (LockedRub). Frame and units as in ``rotortd.contact``.
+bounded; on it, a rigid rotation (LockedRub). Frame and units as in ``rotortd.segments``.
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from .events import WORK_MAX
-from .scaled import wrap_angle
-from .wall import ContactTally, SegmentEnd, WallForces, phase_integral
+from ..contact.search import WORK_MAX
+from ..contact.wall import ContactTally, SegmentEnd, WallForces, phase_integral
+from ..scaled import wrap_angle
 
 
 @dataclass(frozen=True)

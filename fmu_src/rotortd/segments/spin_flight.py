@@ -94,10 +94,10 @@ import cmath
 import math
 from operator import mul
 
-from .bearing import CounterBody
-from .events import WORK_MAX, Work, safe_step
-from .params import RotorParams
-from .wall import ContactWorkExceeded, SegmentEnd
+from ..bodies.bearing import CounterBody
+from ..contact.search import WORK_MAX, Work, safe_step
+from ..contact.wall import ContactWorkExceeded, SegmentEnd
+from ..params import RotorParams
 
 EPS = 2.220446049250313e-16
 TINY = 5e-324
@@ -152,7 +152,7 @@ class SpinFlight:
     p: rotor parameters; J: polar inertia about the mass centre (kg m^2, > 0); a: AMB on in
     [0, 1]; F_ext: external force at the geometric centre (N, complex, without gravity);
     T_drive: drive torque (N m). ``force_integration`` uses the Taylor method even when the
-    closed form applies (for tests). ``bearing``: the counter-body (``rotortd.bearing``);
+    closed form applies (for tests). ``bearing``: the counter-body (``rotortd.bodies.bearing``);
     None is the chapter's, fixed at the origin. When its centre moves (``bearing.moves``)
     the search follows the gap to it, G = |z - c(s)|^2/c_r^2 - 1, with the bounds of its
     path added to the rotor's (|z - c| <= c_r, |z| <= c_r + |c|).

@@ -3,7 +3,7 @@
 Frame and units: inertial, SI. The rotor (geometric centre z, radius R) meets the bearing's
 race, a circle of bore radius R_b = R + c_r whose centre is ``centre``: the rotor touches it
 when |z - centre| = c_r, with the outward normal n = (z - centre)/c_r and the tangent i n.
-A counter-body owns what the contact pair (``rotortd.pair``) needs of it:
+A counter-body owns what the contact pair (``rotortd.contact.pair``) needs of it:
 
 - its motion: ``centre`` (m) and ``velocity`` (m/s) of the race's centre;
 - ``surface_speed`` (m/s): the race surface's speed along i n at the contact, R_b omega_b
@@ -18,7 +18,7 @@ A counter-body owns what the contact pair (``rotortd.pair``) needs of it:
   (|c|, |c'|, |c''|, |c'''|, |c''''|) on [s, s + tau], and ``rate`` (1/s), the fastest
   rate of that path (the search's horizon is a fraction of 1/rate);
 - ``KIND`` and ``record()``: its kind and its state as a plain dict; the core's state
-  (``rotortd.state``, JSON ``rotortd-state`` 3) holds them as its "bearing" record.
+  (``rotortd.step.state``, JSON ``rotortd-state`` 3) holds them as its "bearing" record.
 
 ``FixedRigidBearing`` is the chapter's bearing (docs/model.md §1): fixed at the origin,
 rigid, not turning; it takes no share of W and no impulse changes it. A race that turns, a
@@ -67,7 +67,7 @@ class FixedRigidBearing:
     moves = False
     rate = 0.0
     KIND = "fixed-rigid"
-    """The "kind" of its state record (``rotortd.state``)."""
+    """The "kind" of its state record (``rotortd.step.state``)."""
 
     def __init__(self, *, c_r: float) -> None:
         self.c_r = c_r

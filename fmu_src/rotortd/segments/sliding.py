@@ -1,6 +1,6 @@
 """Sliding on the clearance circle (v_rel != 0), integrated by extrapolation (gbs.py).
 
-Frame and units as in ``rotortd.contact``: Ft = mu s Gn, s = sign(v_rel), at 1e-13 relative
+Frame and units as in ``rotortd.segments``: Ft = mu s Gn, s = sign(v_rel), at 1e-13 relative
 tolerance, with the step's contact integrals carried as error-controlled quadratures (the
 contact force by parts near a steady whirl, Sliding.rhs), and the integral of the
 co-rotating position e^{i(theta - Omega u)} (for the imbalance torque) as an auxiliary
@@ -13,9 +13,9 @@ from __future__ import annotations
 import cmath
 import math
 
+from ..contact.search import WORK_MAX
+from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces
 from . import gbs
-from .events import WORK_MAX
-from .wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""

@@ -21,7 +21,7 @@ JSON's repr; a complex number is [re, im])::
 
 Each leaf is defined once, in FIELDS (its path, the CoreState attribute and its codec);
 ``to_json`` and ``from_json`` are loops over that table. The bearing's record is the
-counter-body's own (``rotortd.bearing``: ``KIND`` and ``record()``); the chapter's fixed
+counter-body's own (``rotortd.bodies.bearing``: ``KIND`` and ``record()``); the chapter's fixed
 rigid bearing has no state of its own, so its record is its kind alone. A future
 counter-body (a race that turns, a sprung housing) adds its fields there.
 
@@ -40,8 +40,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from .bearing import FixedRigidBearing
-from .params import ParameterError, RotorParams
+from ..bodies.bearing import FixedRigidBearing
+from ..params import ParameterError, RotorParams
 
 STATE_SCHEMA, STATE_VERSION = "rotortd-state", 3
 READABLE_VERSIONS = (1, 2, 3)

@@ -27,7 +27,7 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from .params import CrossParameterError, RotorParams
+from ..params import CrossParameterError, RotorParams
 
 CAP_HALVINGS = 60
 """Bisection steps of the energetic cap when the impact's kind (stick, or the slide's

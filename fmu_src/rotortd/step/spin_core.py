@@ -24,22 +24,14 @@ import cmath
 import math
 from dataclasses import replace
 
-from .bearing import FixedRigidBearing
-from .events import WORK_MAX
-from .flight_step import starts_contact
-from .impact import Impact
-from .pair import ContactPair
-from .params import InputError, RotorParams, check_finite, check_range
-from .report import (
-    MODE_FREE,
-    MODE_ROLLING,
-    MODE_SLIDING,
-    StepContext,
-    StepReport,
-)
-from .rigid import RigidRotor, check_well_posed
-from .simulator import TouchdownCore
-from .spin_contact import (
+from ..bodies.bearing import FixedRigidBearing
+from ..bodies.rotor import RigidRotor, check_well_posed
+from ..contact.impact import Impact
+from ..contact.pair import ContactPair
+from ..contact.search import WORK_MAX
+from ..contact.wall import SegmentEnd
+from ..params import InputError, RotorParams, check_finite, check_range
+from ..segments.spin_contact import (
     ContactForces,
     ContactModel,
     HeldInputs,
@@ -47,9 +39,17 @@ from .spin_contact import (
     rolling_forces,
     sliding_forces,
 )
-from .spin_flight import SpinFlight, free_acceleration
+from ..segments.spin_flight import SpinFlight, free_acceleration
+from .flight_step import starts_contact
+from .report import (
+    MODE_FREE,
+    MODE_ROLLING,
+    MODE_SLIDING,
+    StepContext,
+    StepReport,
+)
+from .simulator import TouchdownCore
 from .state import CoreState
-from .wall import SegmentEnd
 
 
 class SpinCore(TouchdownCore):

@@ -3,7 +3,7 @@
 Frame and units: inertial, SI. The one place that defines, for the impact law and the
 contact forces alike, the contact's geometry and kinematics between the rotor
 (``rigid.RigidRotor``: geometric centre z, velocity v, spin Omega, spin angle psi) and the
-counter-body (``rotortd.bearing``: race centre c, velocity v_b, surface speed u_b along
+counter-body (``rotortd.bodies.bearing``: race centre c, velocity v_b, surface speed u_b along
 i n):
 
     gap        |z - c|^2 - c_r^2                      (m^2; contact at 0)
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .bearing import CounterBody
-from .rigid import Delassus, RigidRotor, SpinReset, spin_impact
+from ..bodies.bearing import CounterBody
+from ..bodies.rotor import Delassus, RigidRotor, SpinReset, spin_impact
 
 
 @dataclass(frozen=True, slots=True)

@@ -29,12 +29,12 @@ import cmath
 import math
 from collections.abc import Callable
 
-from .events import WORK_MAX, ContactLocator, Work, flight_is_clear
-from .flight import FlightModel
-from .impact import Impact, reset
+from ..contact.impact import Impact, reset
+from ..contact.search import WORK_MAX, ContactLocator, Work, flight_is_clear
+from ..contact.wall import SegmentEnd
+from ..scaled import TWO_PI_HI, TWO_PI_LO
+from ..segments.flight import FlightModel
 from .report import StepContext, StepReport
-from .scaled import TWO_PI_HI, TWO_PI_LO
-from .wall import SegmentEnd
 
 ETA_HEIGHT = 1e-14
 """Rule (1): rebound height below ETA_HEIGHT c_r counts as contact."""

@@ -35,8 +35,8 @@ import cmath
 import math
 from typing import NamedTuple
 
+from ..params import RotorParams
 from .divdiff import dd2, dd3, dd4
-from .params import RotorParams
 
 IMB_COND = 1e-2
 """imb_integral_ends solves for K from the flight's two ends only when |kappa - Omega^2 +
