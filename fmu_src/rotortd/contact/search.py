@@ -38,6 +38,7 @@ import math
 from dataclasses import dataclass
 
 from ..segments.flight import FlightModel, Modes
+from .events import Event
 
 EPS = 2.220446049250313e-16
 TOL_G_ULPS = 64.0
@@ -98,8 +99,8 @@ class Contact:
     """First contact of a flight: local time ``s`` (s), state z (m), v (m/s), phasor E.
     (Slotted, not frozen: a frozen dataclass's construction cost 590 ns, one per flight.)
 
-    ``kind`` is "impact" (moving outward, normal speed resolved), "touch" (normal speed
-    zero to resolution, free motion curving outward into the wall) or "clear" (no contact
+    ``kind`` (``Event``) is IMPACT (moving outward, normal speed resolved), TOUCH (normal speed
+    zero to resolution, free motion curving outward into the wall) or CLEAR (no contact
     up to ``s``: the search used its MAX_ADVANCES and the caller resumes from there).
     """
 
@@ -107,7 +108,7 @@ class Contact:
     z: complex
     v: complex
     E: complex
-    kind: str
+    kind: Event
 
 
 def _cubic(g0: float, g1: float, g2: float, g3: float, u: float) -> float:
@@ -348,7 +349,7 @@ class ContactLocator:
         """First contact in (0, h], or None. ``on_wall``: the start lies on the circle.
 
         At most min(limit, MAX_ADVANCES) advances (at least one), each of which costs at
-        least one work unit; then it returns a "clear" contact where it stopped. The caller
+        least one work unit; then it returns a CLEAR contact where it stopped. The caller
         passes the work left in its step, so a search never runs past the step's bound.
 
         Each advance bounds g over tau = min(remaining, horizon) by the cubic with the
@@ -426,7 +427,7 @@ class ContactLocator:
                     u = tau
                 if u <= 0.0:
                     # at the wall with g1 = g2 = 0 and nothing pushing: treat as touch
-                    return Contact(s, z, v, E, "touch")
+                    return Contact(s, z, v, E, Event.TOUCH)
                 s = s + u if u < remaining else h
             if modal == 0:
                 md = self._get_modes()
@@ -443,7 +444,7 @@ class ContactLocator:
             e2 = a2 * exp(l2 * s)
             zs = Z1 * rot
             z, v, E = Z0 + zs + e1 + e2, iw * zs + l1 * e1 + l2 * e2, E0 * rot
-        return Contact(s, z, v, E, "clear")  # proved free of contact up to s; resume there
+        return Contact(s, z, v, E, Event.CLEAR)  # proved free of contact up to s; resume there
 
     def _at_wall(
         self,
@@ -466,12 +467,12 @@ class ContactLocator:
             outward = g + g1 * g1 / (-2.0 * g2) > self.tol_g  # resolvable excursion
         if outward:
             if first:
-                return Contact(s, z, v, E, "impact")
+                return Contact(s, z, v, E, Event.IMPACT)
             return self._polish(s, z, v, E, g, g1, work)
         if g1 < -tol_g1:
             return None
         if g2 > tol_g2 or (g2 >= -tol_g2 and self.g3(z, v, E) > 0.0):
-            return Contact(s, z, v, E, "touch")
+            return Contact(s, z, v, E, Event.TOUCH)
         return None
 
     def _polish(
@@ -494,4 +495,4 @@ class ContactLocator:
             if abs(g) <= 4.0 * EPS * self.c2:
                 break
         _, s, z, v, E = best
-        return Contact(s, z, v, E, "impact")
+        return Contact(s, z, v, E, Event.IMPACT)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from ..params import RotorParams
 from ..segments.divdiff import dd2
+from .events import Event
 from .search import G2_FLOOR
 
 
@@ -143,11 +144,8 @@ class SegmentEnd:
     """Contact: polar angle of the contact point at the end (rad, inertial)."""
     dtheta: float = math.nan
     """Contact: whirl rate theta' at the end (rad/s)."""
-    event: str | None = None
-    """None (rem reached); flight: "impact", "touch" (held spin; "clear": the search
-    stopped at its advance limit, resume from the end), "contact" (spin a state); contact:
-    "lift_off", "slip_zero", "slip_stuck", "cone" (held spin), "slip_start" (spin a
-    state)."""
+    event: Event | None = None
+    """None (rem reached), else the ``Event`` that ended the segment."""
     tally: ContactTally | None = None
     """Contact: the segment's contact integrals (per unit m c_r); None for a flight."""
     next_step: float = math.inf

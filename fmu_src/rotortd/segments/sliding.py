@@ -13,6 +13,7 @@ from __future__ import annotations
 import cmath
 import math
 
+from ..contact.events import Event
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces
 from . import gbs
@@ -315,8 +316,8 @@ class Sliding:
             else:  # never off the surface: the event is immediate
                 y_x, _ = at(H * 2.0**-40)
                 kind = self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
-                stuck = kind == "slip_zero" and abs(sv0) <= noise * s_v
-                return H * 2.0**-40, y_x, "slip_stuck" if stuck else kind
+                stuck = kind is Event.SLIP_ZERO and abs(sv0) <= noise * s_v
+                return H * 2.0**-40, y_x, Event.SLIP_STUCK if stuck else kind
         hi, y_best = H, y_hi
         side = 0
         for _ in range(100):
@@ -338,6 +339,6 @@ class Sliding:
                 side = 1
         return hi, y_best, self._kind(y_best, u + hi, s_n, s_v)
 
-    def _kind(self, y: list[float], u: float, s_n: float, s_v: float) -> str:
+    def _kind(self, y: list[float], u: float, s_n: float, s_v: float) -> Event:
         gn, sv = self.events(y, u)
-        return "lift_off" if gn / s_n <= sv / s_v else "slip_zero"
+        return Event.LIFT_OFF if gn / s_n <= sv / s_v else Event.SLIP_ZERO

@@ -25,8 +25,8 @@ functions (N, v_rel, mu N - |F_t|) are checked at each step's end and at its mid
 cubic Hermite interpolant of the state from both ends' values and slopes), so a sign change
 is seen unless it starts and ends within half a step; it is then located by re-integrating
 the step with its column count fixed (Illinois regula falsi, to 4 ulp of the time).
-Events: "lift_off" (N reaches 0), "slip_zero" (v_rel reaches 0 in sliding), "slip_start"
-(|F_t| reaches mu N in rolling).
+Events (``rotortd.contact.events.Event``): LIFT_OFF (N reaches 0), SLIP_ZERO (v_rel
+reaches 0 in sliding), SLIP_START (|F_t| reaches mu N in rolling).
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..contact.events import Event
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
@@ -215,10 +216,10 @@ class SpinContact:
         and in rolling mu N - |F_t| (slip start), in sliding s v_rel (slip zero)."""
         N, Ft = self._forces(y)[:2]
         if self.rolling:
-            return [("lift_off", N + self.n_slack),
-                    ("slip_start", self.model.mu * N - abs(Ft))]
+            return [(Event.LIFT_OFF, N + self.n_slack),
+                    (Event.SLIP_START, self.model.mu * N - abs(Ft))]
         vrel = self.model.R * y[3] + self.model.c_r * y[1]
-        return [("lift_off", N + self.n_slack), ("slip_zero", vrel * self.s)]
+        return [(Event.LIFT_OFF, N + self.n_slack), (Event.SLIP_ZERO, vrel * self.s)]
 
     def _margin(self, y: Vector) -> float:
         """The least event function (continuous; its first zero is the first event)."""

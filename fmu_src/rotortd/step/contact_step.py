@@ -11,6 +11,7 @@ from __future__ import annotations
 import cmath
 import math
 
+from ..contact.events import Event
 from ..contact.wall import SegmentEnd, WallForces
 from ..scaled import wrap_angle
 from ..segments.rolling import Rolling
@@ -158,23 +159,23 @@ class ContactSteps:
         dd = 0.0 if self._mode == MODE_ROLLING else gt - wf.mu * self._slip * gn
         return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0
 
-    def _transition(self, event: str | None, st: StepContext | None) -> None:
+    def _transition(self, event: Event | None, st: StepContext | None) -> None:
         wf = self._wf
         if event is None:
             return
-        if event == "lift_off":
+        if event is Event.LIFT_OFF:
             self._lift_off()
-        elif event == "slip_zero":
+        elif event is Event.SLIP_ZERO:
             self._dtheta = -wf.wr
             self._choose_contact_mode()
             self._locked = False
-        elif event == "slip_stuck":  # sliding cannot leave zero slip: it rolls, and
+        elif event is Event.SLIP_STUCK:  # sliding cannot leave zero slip: it rolls, and
             self._dtheta = -wf.wr  # cone violations below resolution are ignored this step
             self._mode = MODE_ROLLING
             self._locked = False
             assert st is not None
             st.roll_lenient = True
-        elif event == "cone":
+        elif event is Event.SLIP_START:
             _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
             self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
 

@@ -26,6 +26,7 @@ from dataclasses import replace
 
 from ..bodies.bearing import FixedRigidBearing
 from ..bodies.rotor import RigidRotor, check_well_posed
+from ..contact.events import Event
 from ..contact.impact import Impact
 from ..contact.pair import ContactPair
 from ..contact.search import WORK_MAX
@@ -307,16 +308,16 @@ class SpinCore(TouchdownCore):
         self._end_segment(end, rep, st, 1.0 + 0j)  # (I_z = 0: T_imb from the spin balance)
         return st.later(s, end.duration) if end.duration < rem else h
 
-    def _transition(self, event: str | None, st: StepContext | None) -> None:
+    def _transition(self, event: Event | None, st: StepContext | None) -> None:
         """Apply a contact segment's event: lift-off to flight, or a new contact mode."""
         if event is None:
             return
         assert st is not None
         held, p = st.held, self._p
-        if event == "lift_off":
+        if event is Event.LIFT_OFF:
             self._leave_wall()
             return
-        if event == "slip_zero":
+        if event is Event.SLIP_ZERO:
             self._dtheta = -p.R * self._inputs[0] / p.c_r
             mode, s = self._contact_mode(held, 0.0)
         else:  # slip_start: rolling can no longer hold
