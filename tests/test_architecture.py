@@ -15,7 +15,7 @@ SRC = Path(__file__).resolve().parents[1] / "fmu_src"
 
 # The standard-library modules the physics core may use: docs/architecture.md lists the same.
 CORE_ALLOWED = {"__future__", "math", "cmath", "dataclasses", "typing", "collections",
-                "bisect", "operator"}
+                "bisect", "operator", "enum"}
 ALLOWED = {
     "rotortd": CORE_ALLOWED,
     "rotortd_drive": CORE_ALLOWED,
