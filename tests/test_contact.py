@@ -82,7 +82,7 @@ def test_forward_rub_equilibria_match_independent_solution() -> None:
 
 def test_chattering_from_rest_ends_on_the_forward_rub() -> None:
     p = _gamma(0.3)
-    core = TouchdownCore.from_scaled(p, W0, 0j, 0j)
+    core = TouchdownCore.from_scaled(p, W0, U0=0j, dU0=0j)
     reps = _run(core, 400.0 / W0, 1e-3)
     assert core.mode == MODE_SLIDING
     k = core.kinematics(W0)
@@ -153,7 +153,8 @@ def test_lift_off_time_matches_high_precision_sliding() -> None:
     p = BASE.replace(e_c=0.0, mu=0.3)
     wn = math.sqrt(p.k / p.m)
     th0, w0 = 0.4, 1.6 * wn
-    core = TouchdownCore(p, p.c_r * cmath.exp(1j * th0), 1j * p.c_r * w0 * cmath.exp(1j * th0))
+    n0 = cmath.exp(1j * th0)
+    core = TouchdownCore(p, z0=p.c_r * n0, v0=1j * p.c_r * w0 * n0)
     events = []
     while core.mode != MODE_FREE or core.t == 0.0:
         t = core.t
@@ -211,7 +212,7 @@ def test_step_split_independence_with_sustained_contact() -> None:
 def test_spin_reversal_while_sliding_keeps_the_whirl() -> None:
     """A host that changes Omega between steps changes the slip direction, not the whirl."""
     p = BASE.replace(k=0.0, c=0.0, e_c=0.0, mu=0.01)
-    core = TouchdownCore(p, p.c_r, 1j * p.c_r * 100.0)  # on the wall, whirling at 100 rad/s
+    core = TouchdownCore(p, z0=p.c_r, v0=1j * p.c_r * 100.0)  # on the wall, whirling at 100 rad/s
     core.step(1e-4, W0)
     assert core.mode == MODE_SLIDING
     w_before = core.kinematics(W0).whirl_rate
@@ -270,7 +271,7 @@ def test_closed_form_rub_steps_agree_with_integrating_the_sliding(t_start: float
     closed-form evaluation (work 1).
     Integrating the same steps by extrapolation instead gives the same state and step
     outputs to the sliding integrator's tolerance."""
-    core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
+    core = TouchdownCore.from_scaled(_gamma(0.3), W0, U0=0j, dU0=0j)
     _run(core, t_start, 1e-3)
     twin = _integrating_twin(core)
     for _ in range(200):
@@ -289,7 +290,7 @@ def test_linearised_rub_is_refused_outside_its_error_budget() -> None:
     (deviation ~2e-6, beyond LINEAR_TOL and its error budget), which QuadraticRub.near
     admits; at 0.2 s (deviation ~3e-4) both refuse. Neither admits a saddle or the wrong
     slip sign."""
-    core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
+    core = TouchdownCore.from_scaled(_gamma(0.3), W0, U0=0j, dU0=0j)
 
     def closed_form() -> object:
         st, wf = core.state, core.wall_forces
@@ -322,8 +323,8 @@ def _sliding_impulse_case(case: str) -> tuple[TouchdownCore, complex, float]:
         p = BASE.replace(mu=0.3, g=9.81)
         th0, w0 = 0.5, 300.0
         e = cmath.exp(1j * th0)
-        return TouchdownCore(p, p.c_r * e, 1j * p.c_r * w0 * e), 200.0 + 100.0j, 0.0
-    core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
+        return TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * w0 * e), 200.0 + 100.0j, 0.0
+    core = TouchdownCore.from_scaled(_gamma(0.3), W0, U0=0j, dU0=0j)
     t_start = {"approach": 0.2, "near_rub": 0.4, "linearised": 0.45}[case]
     while core.t < t_start - 1e-9:
         core.step(1e-3, W0)
@@ -430,9 +431,9 @@ def test_long_step_hands_the_rub_approach_to_the_closed_form() -> None:
     from rotortd_tools.cycles import OMEGA, chapter_params, si_params
 
     p = si_params(chapter_params(gamma=0.3))
-    one = TouchdownCore(p, 0j, 0j)
+    one = TouchdownCore(p, z0=0j, v0=0j)
     work_one = one.step(1.0, OMEGA).work
-    many = TouchdownCore(p, 0j, 0j)
+    many = TouchdownCore(p, z0=0j, v0=0j)
     work_many = sum(many.step(1e-3, OMEGA).work for _ in range(1000))
     assert one.mode == many.mode == MODE_SLIDING
     assert work_one <= 1.1 * work_many, (work_one, work_many)

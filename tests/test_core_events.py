@@ -51,7 +51,7 @@ def _offset_whirl(excess: float) -> tuple[RotorParams, complex, complex, float]:
 @pytest.mark.parametrize("excess", [1e-10, -1e-10])
 def test_grazing_within_one_long_step(excess: float) -> None:
     p, F, z0, v0 = _offset_whirl(excess)
-    core = TouchdownCore(p, z0, v0, psi0=math.pi)
+    core = TouchdownCore(p, z0=z0, v0=v0, psi0=math.pi)
     period = 2 * math.pi / W0
     rep = core.step(3 * period, W0, F)
     if excess > 0:
@@ -104,7 +104,7 @@ def test_impact_times_match_reference(seed: int) -> None:
 
 def test_step_invariants_and_work_cap_over_random_scene() -> None:
     p = BASE.replace(c=0.1 * BASE.m * W0)
-    core = TouchdownCore(p, 0.5 * p.c_r, 0.8j * p.c_r * W0)
+    core = TouchdownCore(p, z0=0.5 * p.c_r, v0=0.8j * p.c_r * W0)
     for i in range(2000):
         h = 1e-4 * (1 + (i % 7))
         rep = core.step(h, W0)
@@ -282,9 +282,9 @@ def test_long_step_keeps_impact_times_to_the_clock() -> None:
 
     cyc = find_period_one_cycle(0.1)
     z0, v0, W = 0.999 * cyc.z0, cyc.v0, OMEGA
-    one = TouchdownCore(cyc.params, z0, v0)
+    one = TouchdownCore(cyc.params, z0=z0, v0=v0)
     long_times = [imp.t for imp in one.step(10.0, W).impacts]
-    many = TouchdownCore(cyc.params, z0, v0)
+    many = TouchdownCore(cyc.params, z0=z0, v0=v0)
     short_times = [imp.t for _ in range(100) for imp in many.step(0.1, W).impacts]
     assert len(long_times) == len(short_times) > 600
     drift = max(abs(a - b) for a, b in zip(long_times, short_times))

@@ -151,7 +151,7 @@ CASES = {
 def test_fuzz_regression(name: str) -> None:
     par, W_ref, U0, dU0, steps = CASES[name]
     p = RotorParams(**par)
-    core = TouchdownCore.from_scaled(p, W_ref, U0, dU0)
+    core = TouchdownCore.from_scaled(p, W_ref, U0=U0, dU0=dU0)
     for h, w_scale, amb, f_scale in steps:
         W = w_scale * W_ref
         F = f_scale * p.m * p.c_r * W_ref**2 * cmath.exp(1.3j)

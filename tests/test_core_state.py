@@ -22,7 +22,7 @@ DATA = Path(__file__).resolve().parent / "data"
 @pytest.mark.parametrize("gamma", [0.3, 0.065, 0.1])
 def test_restore_reproduces_run_bit_for_bit(gamma: float) -> None:
     p = RotorParams().replace(c=gamma * 50 * W0)
-    core = TouchdownCore(p, 0.2 * p.c_r, 0.5j * p.c_r * W0)
+    core = TouchdownCore(p, z0=0.2 * p.c_r, v0=0.5j * p.c_r * W0)
     for _ in range(300):
         core.step(1e-3, W0)
     saved = json.loads(json.dumps(core.get_state()))
@@ -43,7 +43,7 @@ def _step_row(core: TouchdownCore) -> tuple:
 # The recipes of tests/data/core_state_v2.json: run unchanged by rotortd at 726b1b4.
 def _held(gamma: float, n: int) -> TouchdownCore:
     p = RotorParams().replace(c=gamma * 50 * W0)
-    core = TouchdownCore(p, 0.2 * p.c_r, 0.5j * p.c_r * W0)
+    core = TouchdownCore(p, z0=0.2 * p.c_r, v0=0.5j * p.c_r * W0)
     for _ in range(n):
         core.step(1e-3, W0, F, 1.0)
     return core
@@ -112,7 +112,7 @@ def test_v3_layout_round_trips_every_field(name: str) -> None:
     twin = restore_core(doc)
     assert type(twin) is type(core)
     for _ in range(20):
-        kw = {"F_ext": F, "amb_on": 0.0} if core.SPIN_STATE else {"Omega": W0, "F_ext": F}
+        kw = {"F_ext": F, "amb_on": 0.0} if core.spin_is_state else {"Omega": W0, "F_ext": F}
         a, b = core.step(1e-4, **kw), twin.step(1e-4, **kw)
         assert (a.F_contact, a.T_f, a.E_diss) == (b.F_contact, b.T_f, b.E_diss)
     assert twin.get_state() == core.get_state()

@@ -97,7 +97,7 @@ def test_random_scenes_finish_within_the_work_cap(scene: tuple) -> None:
     if abs(U0) >= 1.0:  # on the wall: moving inward or tangentially
         dU0 = complex(min(0.0, (dU0 * U0.conjugate()).real), (dU0 * U0.conjugate()).imag)
         dU0 *= U0
-    core = TouchdownCore.from_scaled(p, W_ref, U0, dU0)
+    core = TouchdownCore.from_scaled(p, W_ref, U0=U0, dU0=dU0)
     for h, w_scale, amb, f_scale in steps:
         W = w_scale * W_ref
         F = f_scale * p.m * p.c_r * W_ref**2 * cmath.exp(1.3j)

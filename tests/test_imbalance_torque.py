@@ -132,7 +132,7 @@ def test_free_flight_step_against_dop853(name: str) -> None:
     coefficients from its second on), or searched with events (the identity with the
     integral of the co-rotating position; whirl_long hits the wall)."""
     p, zr, v0, psi0, h, W, F, a = FLIGHTS[name]
-    core = TouchdownCore(p, zr * p.c_r, v0, psi0)
+    core = TouchdownCore(p, z0=zr * p.c_r, v0=v0, psi0=psi0)
     # the first flight of a length from its ends, the next ones by the coefficients
     for k in range(3 if name != "whirl_long" else 1):
         rep = _check_flight_step(core, h, W, F, a)
@@ -144,7 +144,7 @@ def test_proved_free_and_searched_paths_both_checked() -> None:
     averaging) and the segment loop (a search, here finding nothing)."""
     works = {}
     for name, (p, zr, v0, psi0, h, W, F, a) in FLIGHTS.items():
-        works[name] = TouchdownCore(p, zr * p.c_r, v0, psi0).step(h, W, F, a).work
+        works[name] = TouchdownCore(p, z0=zr * p.c_r, v0=v0, psi0=psi0).step(h, W, F, a).work
     assert works["whirl"] <= 3 and works["searched"] > 3
 
 
@@ -165,7 +165,7 @@ def test_step_with_impacts_against_dop853(name: str) -> None:
     """Impacts within the step (d = 0.95): impulses counted as P/h through the identity's
     boundary terms; the flights between them searched."""
     p, zr, v0, psi0, h, W, F, a, least = IMPACTING[name]
-    core = TouchdownCore(p, zr * p.c_r, v0, psi0)
+    core = TouchdownCore(p, z0=zr * p.c_r, v0=v0, psi0=psi0)
     rep = _check_flight_step(core, h, W, F, a)
     assert len(rep.impacts) >= least and not rep.transitions
 
@@ -225,7 +225,7 @@ def _check_contact_step(core: TouchdownCore, h: float, W: float, F: complex = 0j
 
 
 def _chattering(t_start: float) -> TouchdownCore:
-    core = TouchdownCore.from_scaled(_gamma(0.3), W0, 0j, 0j)
+    core = TouchdownCore.from_scaled(_gamma(0.3), W0, U0=0j, dU0=0j)
     while core.t < t_start - 1e-9:
         core.step(1e-3, W0)
     return core
@@ -269,7 +269,7 @@ def test_sliding_with_gravity_and_force_against_dop853() -> None:
     rub equilibrium, the integrator all the way), over a long step."""
     p = BASE.replace(mu=0.3, g=9.81)
     e = cmath.exp(1j * 0.5)
-    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * 300.0 * e)
+    core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * 300.0 * e)
     core.step(1e-6, W0, 200.0 + 100.0j, 0.0)  # enter contact
     assert core.mode == MODE_SLIDING
     _check_contact_step(core, 5e-3, W0, 200.0 + 100.0j, 0.0)
@@ -297,7 +297,7 @@ def test_step_split_and_zero_imbalance() -> None:
     P2 = sum(short.step(1e-4, W0).P_imb for _ in range(200))
     scale = BASE.e_c * BASE.m * BASE.c_r * W0 * W0 * 60.0 * 0.02  # |F_c| ~ 60 m c_r W^2
     assert abs(P1 - P2) <= TOL * scale
-    core = TouchdownCore.from_scaled(_gamma(0.3, e_c=0.0), W0, 0.9j, 0j)
+    core = TouchdownCore.from_scaled(_gamma(0.3, e_c=0.0), W0, U0=0.9j, dU0=0j)
     for _ in range(50):
         assert core.step(1e-3, W0, 30.0).T_imb == 0.0
 
@@ -310,7 +310,7 @@ def test_spin_state_reports_the_same_torque_from_its_balance() -> None:
     held = TouchdownCore.on_steady_whirl(p, W0)
     for _ in range(37):
         held.step(1e-4, W0, 200.0 + 100j)
-    spin = SpinCore(p, 0.04, held.z, held.v, held.psi, W0, held.t)
+    spin = SpinCore(p, 0.04, z0=held.z, v0=held.v, psi0=held.psi, Omega0=W0, t0=held.t)
     a = held.step(1e-5, W0, 200.0 + 100j)
     b = spin.step(1e-5, F_ext=200.0 + 100j, T_drive=3.0)
     assert not a.impacts and not b.impacts and abs(a.T_imb) > 1e-3
@@ -342,8 +342,8 @@ def test_switched_off_the_motion_is_the_same_to_the_bit(gamma: float) -> None:
     quadrature no longer refined) and rolling, over 1 s at 1e-3 s steps."""
     W0 = 184.2
     p = RotorParams().replace(c=gamma * 50 * W0)
-    on = TouchdownCore(p, 0.2 * p.c_r, 0.5j * p.c_r * W0)
-    off = TouchdownCore(p, 0.2 * p.c_r, 0.5j * p.c_r * W0)
+    on = TouchdownCore(p, z0=0.2 * p.c_r, v0=0.5j * p.c_r * W0)
+    off = TouchdownCore(p, z0=0.2 * p.c_r, v0=0.5j * p.c_r * W0)
     off.imbalance_torque = False
     modes = set()
     for _ in range(1000):

@@ -82,7 +82,7 @@ def test_state_conversions_are_the_cores_bit_for_bit() -> None:
         psi = rng.uniform(-3.1, 3.1)
         U = complex(rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6))
         dU = complex(rng.uniform(-2, 2), rng.uniform(-2, 2))
-        core = TouchdownCore.from_scaled(p, W, U, dU, psi)
+        core = TouchdownCore.from_scaled(p, W, U0=U, dU0=dU, psi0=psi)
         z, v = S.to_inertial(U, dU, W, p.c_r, psi)
         assert (z, v) == (core.z, core.v)
         k = core.kinematics(W)
@@ -90,7 +90,7 @@ def test_state_conversions_are_the_cores_bit_for_bit() -> None:
         assert (U2.real, U2.imag, dU2.real, dU2.imag) == (k.u_re, k.u_im, k.du_re, k.du_im)
         assert abs(U2 - U) < 1e-14 and abs(dU2 - dU) < 1e-12
     assert S.to_scaled(1e-4 + 0j, 1j, 0.0, p.c_r, 0.0)[1] == 0j
-    slow = TouchdownCore(p, 1e-4 + 0j, 1j)  # c_r Omega underflows: the Omega = 0 convention
+    slow = TouchdownCore(p, z0=1e-4 + 0j, v0=1j)  # c_r Omega underflows: the Omega = 0 convention
     k = slow.kinematics(1e-320)
     assert S.to_scaled(slow.z, slow.v, 1e-320, p.c_r, 0.0)[1] == complex(k.du_re, k.du_im) == 0
 

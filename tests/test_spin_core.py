@@ -13,7 +13,7 @@ import math
 
 import pytest
 from rotortd import MODE_ROLLING, MODE_SLIDING, STATUS_OK, CrossParameterError, RotorParams
-from rotortd.step.spin_core import SpinCore, restore_core
+from rotortd import SpinCore, restore_core
 
 CHAPTER_G = RotorParams(g=9.81)
 J_HALF = 0.5 * CHAPTER_G.m * CHAPTER_G.R ** 2  # 0.04 kg m^2
@@ -47,7 +47,7 @@ def test_conservation_scene_keeps_momentum_and_energy(d: float) -> None:
     through the bearing centre, so L is conserved through impacts and contact; with d = 1
     the energy too (docs/model.md §8). Over 1 s, to 1e-12 relative."""
     p = RotorParams(mu=0.0, g=0.0, d=d)
-    core = SpinCore(p, J_HALF, 0.3e-3 + 0.1e-3j, 0.08 - 0.05j, 0.4, 184.2)
+    core = SpinCore(p, J_HALF, z0=0.3e-3 + 0.1e-3j, v0=0.08 - 0.05j, psi0=0.4, Omega0=184.2)
     b0 = _body(core)
     _run(core, 1e-3, 1000, amb_on=0.0)
     b1 = _body(core)
@@ -144,7 +144,7 @@ def test_energy_balance_closes_with_the_bearing_on() -> None:
     integrated (Taylor). T + V changes by the drive's work minus the dissipation, to below
     1e-10 of the sum of the terms' magnitudes."""
     p = RotorParams(g=9.81, c=0.0)
-    core = SpinCore(p, J_HALF, 0j, 0j, 0.0, 184.2)
+    core = SpinCore(p, J_HALF, z0=0j, v0=0j, psi0=0.0, Omega0=184.2)
 
     def stored() -> float:
         zG = core.z + p.e_c * cmath.exp(1j * (core.psi + p.phi))
@@ -167,7 +167,7 @@ def test_energy_balance_closes_with_the_damper() -> None:
     T + V changes by the drive's and F_ext's work minus friction and damper losses, to below
     1e-10 of the sum of the terms' magnitudes."""
     p, F, T, h, n = RotorParams(g=9.81), -3000j, 5.0, 2e-6, 25000
-    core = SpinCore(p, J_HALF, -1j * p.c_r, 0j, 0.0, 184.2)
+    core = SpinCore(p, J_HALF, z0=-1j * p.c_r, v0=0j, psi0=0.0, Omega0=184.2)
 
     def stored() -> float:
         zG = core.z + p.e_c * cmath.exp(1j * (core.psi + p.phi))
@@ -194,7 +194,47 @@ def test_at_rest_on_the_wall_under_gravity(W: float, theta: float) -> None:
     broken (contact within N's rounding band) instead of zero-length flights until the work
     bound (theta = pi with Omega = 1e-9 stalled so); elsewhere the rotor leaves the wall."""
     p = RotorParams(g=9.81)
-    core = SpinCore(p, J_HALF, p.c_r * cmath.exp(1j * theta), 0j, 0.0, W)
+    core = SpinCore(p, J_HALF, z0=p.c_r * cmath.exp(1j * theta), v0=0j, psi0=0.0, Omega0=W)
     rep = core.step(1e-3, amb_on=0.0)
     assert rep.status == STATUS_OK and rep.work < 10_000 and core.t == pytest.approx(1e-3)
     assert abs(core.z) <= p.c_r * (1 + 1e-12)
+
+
+def test_one_core_for_both_rotors() -> None:
+    """The held spin is the J = inf case of the one core (docs/model.md §8): SpinCore adds
+    no physics (TouchdownCore with a finite J gives the same bits through a drop with
+    impacts and contact), a SpinCore refuses J = inf, and the constructors take every
+    argument after params (and J) by keyword."""
+    from rotortd import InputError, ParameterError, TouchdownCore
+
+    one = TouchdownCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)
+    two = SpinCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)
+    assert one.spin_is_state and two.spin_is_state
+    for _ in range(300):
+        one.step(1e-3, amb_on=0.0)
+        two.step(1e-3, amb_on=0.0)
+    assert one.n_impacts > 100 and one.mode == two.mode == MODE_ROLLING
+    assert one.get_state() == two.get_state()
+    held = TouchdownCore(CHAPTER_G)
+    assert not held.spin_is_state and held.J == math.inf
+    with pytest.raises(ParameterError, match="J"):
+        SpinCore(CHAPTER_G, math.inf)
+    with pytest.raises(TypeError):
+        TouchdownCore(CHAPTER_G, 0j)  # type: ignore[misc]
+    with pytest.raises(TypeError):
+        SpinCore(CHAPTER_G, J_HALF, 0j)  # type: ignore[misc]
+    with pytest.raises(InputError, match="T_drive = 1.0 N m: the spin is held"):
+        held.step(1e-3, 184.2, T_drive=1.0)
+    with pytest.raises(InputError, match="Omega is missing"):
+        held.step(1e-3)
+    assert held.t == 0.0
+
+
+def test_wall_forces_follow_the_spin_state() -> None:
+    """After a drop with the bearing off, the wall forces are those of the spin speed now
+    and the last inputs (at e272741 they kept Omega = 0 and the bearing on)."""
+    core = SpinCore.on_steady_whirl(CHAPTER_G, 184.2, J=J_HALF)
+    _run(core, 1e-3, 50, amb_on=0.0)
+    wf = core.wall_forces
+    assert core.Omega != 184.2
+    assert wf.Omega == core.Omega and wf.kappa == wf.beta == 0.0  # kappa = a k/m, beta = a c/m

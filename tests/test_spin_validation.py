@@ -59,7 +59,7 @@ def _drop(J: float, h: float, dz: float = 0.0) -> tuple[np.ndarray, np.ndarray, 
     """Omega and mode at every communication point of the drop (the bearing off from
     t = 0, from the held-speed levitated whirl, its position moved by dz c_r)."""
     held = TouchdownCore.on_steady_whirl(P, OMEGA0)
-    core = SpinCore(P, J, held.z + dz * P.c_r, held.v, 0.0, OMEGA0)
+    core = SpinCore(P, J, z0=held.z + dz * P.c_r, v0=held.v, psi0=0.0, Omega0=OMEGA0)
     om, modes, trans = [core.Omega], [core.mode], []
     for _ in range(round(T_END / h)):
         rep = core.step(h, amb_on=0.0)
@@ -123,7 +123,7 @@ def test_run_down_with_the_drive_through_impacts_and_forward_rub() -> None:
     J, W0, h, n = 0.04, 220.0, 1e-3, 900
     ref, spread = _reference_pair(CHAPTER_G, J, W0, n * h, h, a=1.0, T_drive=-4.0)
     held = TouchdownCore.on_steady_whirl(P, W0)
-    core = SpinCore(P, J, held.z, held.v, 0.0, W0)
+    core = SpinCore(P, J, z0=held.z, v0=held.v, psi0=0.0, Omega0=W0)
     om, trans = _run(core, h, n, amb_on=1.0, T_drive=-4.0)
     assert core.n_impacts == len(ref.impacts) > 100
     assert np.max(np.abs(om - ref.samples["Omega"]) - 3.0 * spread) <= 1e-12 * W0

@@ -338,7 +338,7 @@ def test_grazing_impact_speed_grows_like_square_root() -> None:
     for delta in deltas:
         for sign in (+1.0, -1.0):
             core = TouchdownCore.from_scaled(_chapter(gamma=g_graze + sign * delta), W,
-                                             cyc.U0, cyc.dU0, 0.0)
+                                             U0=cyc.U0, dU0=cyc.dU0, psi0=0.0)
             reps = run_checked(core, [(h, W, 0j, 1.0)])
             if sign > 0:
                 assert not reps[0].impacts

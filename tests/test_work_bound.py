@@ -30,7 +30,7 @@ def test_long_step_with_fast_impacts_stops_at_the_bound() -> None:
     thousands of impacts per ms): the cap fires at the real bound; the state is the one
     at the time reported, and the next step goes on from there."""
     p = BASE.replace(e_c=0.1, c=0.0, k=0.0, d=1.0, mu=0.0, c_r=1e-6, m=1e-3)
-    core = TouchdownCore(p, 0j, 1.0 + 0j)
+    core = TouchdownCore(p, z0=0j, v0=1.0 + 0j)
     rep = core.step(10.0, 1e5)
     _assert_capped(rep, core, 0.0, 10.0, WORK_MAX)
     assert "free flight" in rep.message and "impacts in the step" in rep.message
@@ -58,7 +58,7 @@ def test_overflowing_extremes_stop_at_the_bound(case: str) -> None:
     """Finite inputs beyond the FMU's ranges whose flight overflows (NaN states): the
     search cannot make progress, and the step stops at its budget instead of hanging."""
     if case == "vx0 = 1e308":
-        core, F = TouchdownCore(BASE, 0j, 1e308 + 0j), 0j
+        core, F = TouchdownCore(BASE, z0=0j, v0=1e308 + 0j), 0j
     else:
         core, F = TouchdownCore(BASE), -1.7e308 + 0j
         assert core.step(1e-3, W0).status == STATUS_OK
@@ -86,7 +86,7 @@ def test_spin_core_step_with_fast_impacts_stops_at_its_budget() -> None:
     d = 1 (hundreds of impacts per 0.1 ms): the step stops at its budget in free flight,
     says where, and the next step goes on from the state reached."""
     p = BASE.replace(e_c=0.1, c=0.0, k=0.0, d=1.0, mu=0.0, c_r=1e-6, m=1e-3)
-    core = SpinCore(p, 1e-3, 0j, 1.0 + 0j, Omega0=1e5)
+    core = SpinCore(p, 1e-3, z0=0j, v0=1.0 + 0j, Omega0=1e5)
     rep = core.step(10.0, F_ext=0j, amb_on=1.0, T_drive=0.0, budget=50_000)
     _assert_spin_capped(rep, core, 0.0, 10.0, 50_000)
     assert "free flight" in rep.message and "impacts in the step" in rep.message
@@ -100,7 +100,7 @@ def test_spin_core_step_pressed_into_the_wall_stops_at_its_budget() -> None:
     """SpinCore pressed into the bearing by 1e9 N with a drive torque: impacts and contact
     work; a step with a small budget stops inside, says where, and the state it leaves
     continues with an OK step."""
-    core = SpinCore(BASE, 0.04, 0j, 0j, Omega0=W0)
+    core = SpinCore(BASE, 0.04, z0=0j, v0=0j, Omega0=W0)
     F = 1e9 + 0j
     for _ in range(3):
         assert core.step(1e-4, F_ext=F, amb_on=1.0, T_drive=1.0).status == STATUS_OK
@@ -113,7 +113,7 @@ def test_spin_core_step_pressed_into_the_wall_stops_at_its_budget() -> None:
 
 def test_spin_core_default_budget_is_the_core_bound() -> None:
     """Without a budget a SpinCore step gets WORK_MAX, and a budget above it is cut to it."""
-    core = SpinCore(BASE, 0.04, 0j, 0j, Omega0=W0)
+    core = SpinCore(BASE, 0.04, z0=0j, v0=0j, Omega0=W0)
     assert core.step(1e-4).work_cap == WORK_MAX
     assert core.step(1e-4, budget=10 * WORK_MAX).work_cap == WORK_MAX
 
@@ -121,9 +121,9 @@ def test_spin_core_default_budget_is_the_core_bound() -> None:
 def test_spin_core_leaves_the_wall_inward() -> None:
     """On the wall with a tangential velocity, the AMB pulling inward: the rotor must
     leave the wall (TouchdownCore does, in one OK step)."""
-    held = TouchdownCore(BASE, BASE.c_r + 0j, 0.05j)
+    held = TouchdownCore(BASE, z0=BASE.c_r + 0j, v0=0.05j)
     assert held.step(1e-3, W0).status == STATUS_OK
-    core = SpinCore(BASE, 0.04, BASE.c_r + 0j, 0.05j, Omega0=W0)
+    core = SpinCore(BASE, 0.04, z0=BASE.c_r + 0j, v0=0.05j, Omega0=W0)
     rep = core.step(1e-3, budget=20_000)
     assert rep.status == STATUS_OK and core.t == pytest.approx(1e-3)
 
@@ -158,7 +158,7 @@ def test_tiny_spin_speed_behaves_like_zero(W: float) -> None:
     kinematics are finite; the scaled dU/dt, where it would overflow (or divide by
     c_r Omega = 0), is 0 as at Omega = 0."""
     for z0, v0 in ((0j, 0j), (0.5e-3 + 0j, 0.1 + 0.2j), (BASE.c_r + 0j, 0.05j)):
-        core = TouchdownCore(BASE.replace(k=0.0, c=0.0) if z0 == 0 else BASE, z0, v0)
+        core = TouchdownCore(BASE.replace(k=0.0, c=0.0) if z0 == 0 else BASE, z0=z0, v0=v0)
         for i in range(20):
             rep = core.step(1e-3 if i % 2 else 3.7e-3, W, 1e3 + 0j if i > 10 else 0j)
             assert rep.status == STATUS_OK
@@ -166,9 +166,9 @@ def test_tiny_spin_speed_behaves_like_zero(W: float) -> None:
             assert all(math.isfinite(x) for x in kin)
         if BASE.c_r * abs(W) < abs(core.v) / 1.7e308:  # dU/dt = ~v/(c_r Omega) overflows
             assert kin.du_re == 0.0 and kin.du_im == 0.0
-    zero = TouchdownCore(BASE, 0.5e-3 + 0j, 0.1 + 0.2j).kinematics(0.0, 1.0)
+    zero = TouchdownCore(BASE, z0=0.5e-3 + 0j, v0=0.1 + 0.2j).kinematics(0.0, 1.0)
     assert zero.du_re == 0.0 and zero.du_im == 0.0
-    spin = SpinCore(BASE, 0.04, 0.5e-3 + 0j, 0.1 + 0.2j, Omega0=W)  # the spin a state
+    spin = SpinCore(BASE, 0.04, z0=0.5e-3 + 0j, v0=0.1 + 0.2j, Omega0=W)  # the spin a state
     for i in range(10):
         rep = spin.step(1e-3 if i % 2 else 3.7e-3, F_ext=0j, amb_on=1.0, T_drive=0.0)
         assert rep.status == STATUS_OK and math.isfinite(spin.Omega)

@@ -111,7 +111,7 @@ sc, mode, n = D[sys.argv[2]], sys.argv[3], int(sys.argv[4])
 p = RotorParams(**sc["params"])
 imb = os.environ.get("BENCH_IMBALANCE_TORQUE") == "1"
 for _ in range(n):
-    core = TouchdownCore(p, sc["z0"], sc["v0"], sc["psi0"])
+    core = TouchdownCore(p, z0=sc["z0"], v0=sc["v0"], psi0=sc["psi0"])
     if hasattr(core, "imbalance_torque"):  # (a core before it had no T_imb at all)
         core.imbalance_torque = imb
     t = 0.0

@@ -266,7 +266,7 @@ def timed(fn: Callable[[], RunResult], repeats: int) -> tuple[list[float], RunRe
 
 def run_core(sc: Scene, h: float = H_CORE, t_end: float = T_END,
              step_times: list[float] | None = None) -> RunResult:
-    core = TouchdownCore(sc.params, sc.z0, sc.v0, sc.psi0)
+    core = TouchdownCore(sc.params, z0=sc.z0, v0=sc.v0, psi0=sc.psi0)
     imps: dict[int, tuple[float, float]] = {}
     ok, n = True, round(t_end / h)
     clock = time.perf_counter
@@ -284,7 +284,7 @@ def run_core(sc: Scene, h: float = H_CORE, t_end: float = T_END,
 def run_core_segments(sc: Scene) -> RunResult:
     """The core called once per held-input segment of the scene (Scene.segments), as the
     direct integrators take it: one call for the whole second, two for the drop."""
-    core = TouchdownCore(sc.params, sc.z0, sc.v0, sc.psi0)
+    core = TouchdownCore(sc.params, z0=sc.z0, v0=sc.v0, psi0=sc.psi0)
     imps: dict[int, tuple[float, float]] = {}
     ok, t = True, 0.0
     for t_end, omega, force, amb in sc.segments():
@@ -597,10 +597,10 @@ def scaling_time(scenes: dict[str, Scene], quick: bool) -> list[dict[str, Any]]:
 def scaling_impacts(sc: Scene) -> dict[str, Any]:
     """Per-step cost of the core vs impacts in the step (least squares, limit cycle)."""
     st: list[float] = []
-    core = TouchdownCore(sc.params, sc.z0, sc.v0, sc.psi0)
+    core = TouchdownCore(sc.params, z0=sc.z0, v0=sc.v0, psi0=sc.psi0)
     n_imp = []
     for _ in range(5):
-        core = TouchdownCore(sc.params, sc.z0, sc.v0, sc.psi0)
+        core = TouchdownCore(sc.params, z0=sc.z0, v0=sc.v0, psi0=sc.psi0)
         for _j in range(round(T_END / H_CORE)):
             t0 = time.perf_counter()
             rep = core.step(H_CORE, W)

@@ -72,7 +72,7 @@ def _core_run(core: SpinCore, h: float, n: int, **ins: float) -> dict[str, Any]:
 
 def _drop_core(J: float, h: float, dz: float = 0.0) -> dict[str, Any]:
     held = TouchdownCore.on_steady_whirl(P_G, OMEGA0)
-    core = SpinCore(P_G, J, held.z + dz * P_G.c_r, held.v, 0.0, OMEGA0)
+    core = SpinCore(P_G, J, z0=held.z + dz * P_G.c_r, v0=held.v, psi0=0.0, Omega0=OMEGA0)
     return _core_run(core, h, round(DROP_END / h), amb_on=0.0)
 
 
@@ -98,7 +98,7 @@ def task(name: str, *args: float) -> tuple[str, tuple, Any]:
         out = _ref_summary(res, CHAPTER_G["c_r"])
     elif name == "rundown_core":
         held = TouchdownCore.on_steady_whirl(P_G, RUNDOWN["W0"])
-        core = SpinCore(P_G, RUNDOWN["J"], held.z, held.v, 0.0, RUNDOWN["W0"])
+        core = SpinCore(P_G, RUNDOWN["J"], z0=held.z, v0=held.v, psi0=0.0, Omega0=RUNDOWN["W0"])
         out = _core_run(core, RUNDOWN["h"], RUNDOWN["n"], amb_on=1.0,
                         T_drive=RUNDOWN["T_drive"])
     elif name == "rundown_ref":  # (rtol,)
@@ -142,8 +142,8 @@ def balances() -> dict[str, Any]:
     """The conservation scenes and the energy balance of tests/test_spin_core.py."""
     out: dict[str, Any] = {}
     for d in (1.0, 0.8):
-        core = SpinCore(RotorParams(mu=0.0, g=0.0, d=d), J_HALF, 0.3e-3 + 0.1e-3j,
-                        0.08 - 0.05j, 0.4, 184.2)
+        core = SpinCore(RotorParams(mu=0.0, g=0.0, d=d), J_HALF, z0=0.3e-3 + 0.1e-3j,
+                        v0=0.08 - 0.05j, psi0=0.4, Omega0=184.2)
         b0 = _body(core)
         for _ in range(1000):
             core.step(1e-3, amb_on=0.0)

@@ -92,11 +92,11 @@ def run_scene(scene: dict, t_limit: float, verbose: bool = False) -> dict:
     spin = scene["spin"]
     if spin:
         try:
-            core = SpinCore(p, scene["J"], z0, v0, scene["psi0"], Omega0=ins[0]["Omega"])
+            core = SpinCore(p, scene["J"], z0=z0, v0=v0, psi0=scene["psi0"], Omega0=ins[0]["Omega"])
         except CrossParameterError as exc:  # J too small for well-posed contact: refused
             return {"steps": [], "refused": str(exc)[:300]}
     else:
-        core = TouchdownCore(p, z0, v0, scene["psi0"])
+        core = TouchdownCore(p, z0=z0, v0=v0, psi0=scene["psi0"])
     steps = []
     total = 0.0
     for i in range(scene["n_steps"]):

@@ -19,11 +19,12 @@ from .step.simulator import (
     STATUS_WORK_CAP,
     WORK_MAX,
     Kinematics,
+    SpinCore,
     StepReport,
     TouchdownCore,
+    restore_core,
     work_cap,
 )
-from .step.spin_core import SpinCore, restore_core
 
 __all__ = [
     "LIMITS",

@@ -255,7 +255,7 @@ class RotorTouchdownAdapter(GuardedSlave):
                              f"model time {t!r}")
         omega, f_ext, amb, t_drive = self._step_inputs  # validated by _check_changes
         t_target = t + step_size
-        if core.SPIN_STATE:
+        if core.spin_is_state:
             rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
         else:
             rep = core.step(step_size, omega, f_ext, amb)
@@ -389,7 +389,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             import rotortd
 
             core = rotortd.restore_core(copy.deepcopy(core_state))
-            if bool(values["integrate_spin"]) != core.SPIN_STATE:
+            if bool(values["integrate_spin"]) != core.spin_is_state:
                 raise ModelError("the core state does not match integrate_spin")
         t0, failure = float(adapter["t0"]), str(adapter["failure"])
         fixed_snapshot = dict(adapter["fixed_snapshot"])

@@ -1,16 +1,22 @@
 """The event-driven simulator: exact flight, located impacts, sustained contact.
 
-Frame and units: inertial, SI, unless a name says otherwise. ``TouchdownCore.step``
-advances the rotor by one communication step with inputs held (Omega, F_ext, a) and
-returns a ``StepReport``. The story it resolves:
+Frame and units: inertial, SI, unless a name says otherwise. One core, ``TouchdownCore``,
+for the one model: the rotor is a rigid body with polar inertia J whose spin is a state
+(docs/model.md §8); the held-spin rotor is its J = inf case, with Omega an input of each
+step (docs/model.md §1-§7). ``TouchdownCore.step`` advances the rotor by one communication
+step with its inputs held (F_ext, a, and Omega with the spin held or T_drive with the spin
+a state) and returns a ``StepReport``. The story it resolves:
 
     free flight -> impacts -> chattering -> sliding <-> rolling -> lift-off -> free flight
 
-The step's segments live in two mixins, by job: ``flight_step.FlightSteps`` (free flight,
-the contact search, impacts and the low-speed rule that turns an impact into contact) and
-``contact_step.ContactSteps`` (sustained contact: the mode choice, lift-off, sliding,
-rolling, the rub in closed form, the lock). The report and the step context are in
-``report``, the state record in ``state``.
+One step loop (``_segments``) strings the segments together; each segment is chosen where
+the last ended. The segment choices live in mixins, by job: ``flight_step.FlightSteps``
+(free flight, the contact search, impacts and the low-speed rule), ``contact_step.
+ContactSteps`` (sustained contact: the mode choice, lift-off, sliding, rolling, the rub in
+closed form, the lock), both the held spin's declared accelerators (closed-form flight
+and rolling, the rub), and ``spin_step.SpinSteps``, bound in their place when the spin is
+a state (``_bind_rotor``). ``SpinCore`` is this core with J required. The report and the
+step context are in ``report``, the state record in ``state``.
 """
 
 from __future__ import annotations
@@ -18,6 +24,9 @@ from __future__ import annotations
 import cmath
 import math
 
+from ..bodies.bearing import FixedRigidBearing
+from ..bodies.rotor import RigidRotor, check_well_posed
+from ..contact.pair import ContactPair
 from ..contact.search import SEGMENT_WORK, WORK_MAX
 from ..contact.wall import ContactWorkExceeded, WallForces, phase_integral
 from ..limits import CrossParameterError, start_position
@@ -46,27 +55,39 @@ from .report import (
     stop_at_work_bound,
     work_cap,
 )
+from .spin_step import SpinSteps
 from .state import CoreState, fixed_bearing_record
 
 __all__ = [
     "ETA_HEIGHT", "ETA_TIME", "LOCK_TOL", "MODE_FREE", "MODE_ROLLING", "MODE_SLIDING",
     "N_CASCADE", "RUB_RETRY", "STATUS_OK", "STATUS_WORK_CAP", "WORK_MAX", "Kinematics",
-    "StateOutputs", "StepReport", "TouchdownCore", "WorkCapExceeded", "work_cap",
+    "SpinCore", "StateOutputs", "StepReport", "TouchdownCore", "WorkCapExceeded",
+    "restore_core", "work_cap",
 ]
+INF = math.inf
 
 
-class TouchdownCore(FlightSteps, ContactSteps):
-    """Rotor in a touchdown bearing, advanced step by step (see the module docstring)."""
+class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
+    """Rotor in a touchdown bearing, advanced step by step (see the module docstring).
 
-    SPIN_STATE = False
-    """The spin speed is a held input (False) or a state (SpinCore: True)."""
+    J (kg m^2, > 0): the polar inertia about the mass centre; inf (the default) holds the
+    spin (Omega an input of each step), a finite J makes it a state starting at Omega0
+    (rad/s; CrossParameterError when J is too small for the contact to be well posed).
+    z0 (m), v0 (m/s): the rotor centre's start (inertial); psi0 (rad) the spin angle;
+    t0 (s) the clock."""
+
+    _pair: ContactPair | None = None  # the contact pair, built for _pair_of (params, J)
+    _pair_of: tuple[RotorParams, float] | None = None
 
     def __init__(
         self,
         params: RotorParams,
+        *,
+        J: float = INF,
         z0: complex = 0j,
         v0: complex = 0j,
         psi0: float = 0.0,
+        Omega0: float = 0.0,
         t0: float = 0.0,
     ) -> None:
         z0, v0 = complex(z0), complex(v0)
@@ -76,9 +97,14 @@ class TouchdownCore(FlightSteps, ContactSteps):
             ("vx0", v0.real),
             ("vy0", v0.imag),
             ("psi0", psi0),
+            ("Omega0", Omega0),
             ("t0", t0),
         ):
             check_finite(name, val)
+        self._J = INF
+        if J != INF:  # (a NaN too: check_range names it)
+            self._J = check_range("J", J, 0.0, lo_open=True, unit="kg m^2")
+            check_well_posed(params, self._J)
         z0 = start_position(z0, params.c_r)
         self._p = params
         self._t = float(t0)
@@ -105,8 +131,19 @@ class TouchdownCore(FlightSteps, ContactSteps):
         and chattering benchmark scenes) and reports NaN; the motion is the same to the last
         bit. A setting of the object, not of the
         state (get_state and set_state leave it as it is)."""
-        self._set_inputs(0.0, 0j, 1.0)  # the flight and wall models of the held inputs
+        self._set_inputs(float(Omega0), 0j, 1.0)  # the flight and wall models of the inputs
+        self._bind_rotor()
 
+    def _bind_rotor(self) -> None:
+        """Bind the segment choices of the rotor's spin model: the held spin's are the
+        class's own (FlightSteps, ContactSteps); with the spin a state (J finite) the
+        instance takes SpinSteps' in their place, for the same step loop."""
+        held = self._J == INF
+        for name in ("_advance_free", "_advance_contact", "_advance_spin", "_transition"):
+            if held:
+                self.__dict__.pop(name, None)
+            else:
+                setattr(self, name, getattr(self, "_spin" + name))
     # ------------------------------------------------------------------ constructors
 
     @classmethod
@@ -114,6 +151,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
         cls,
         params: RotorParams,
         Omega: float,
+        *,
         U0: complex = 0j,
         dU0: complex = 0j,
         psi0: float = 0.0,
@@ -124,19 +162,22 @@ class TouchdownCore(FlightSteps, ContactSteps):
         if W == 0.0:
             raise ParameterError("Omega = 0.0 rad/s: a scaled initial state needs Omega != 0")
         z0, v0 = to_inertial(U0, dU0, W, params.c_r, psi0)
-        return cls(params, z0, v0, psi0, t0)
+        return cls(params, z0=z0, v0=v0, psi0=psi0, Omega0=W, t0=t0)
 
     @classmethod
     def on_steady_whirl(
         cls,
         params: RotorParams,
         Omega: float,
+        *,
         F_ext: complex = 0j,
         amb_on: float = 1.0,
         psi0: float = 0.0,
         t0: float = 0.0,
+        J: float = INF,
     ) -> TouchdownCore:
-        """Start on the steady free whirl z = Z0 + Z1 e^{i psi} (the regular equilibrium U*).
+        """Start on the steady free whirl z = Z0 + Z1 e^{i psi} (the regular equilibrium U*)
+        of the held spin Omega (rad/s); with J finite the spin is a state starting there.
 
         Raises ParameterError when it does not exist (no stiffness, undamped resonance) or
         is not admissible (it leaves the clearance).
@@ -160,7 +201,8 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 f"start_steady: the steady whirl is not admissible, its radius reaches "
                 f"|Z0| + |Z1| = {(abs(Z0) + abs(Z1)) / params.c_r:.6g} c_r; it must be < 1 c_r"
             )
-        return cls(params, Z0 + Z1, 1j * fm.Omega * Z1, psi0, t0)
+        return cls(params, J=J, z0=Z0 + Z1, v0=1j * fm.Omega * Z1, psi0=psi0, Omega0=Omega,
+                   t0=t0)
 
     # ------------------------------------------------------------------ state access
 
@@ -169,10 +211,42 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """Current parameters."""
         return self._p
 
+    @property
+    def J(self) -> float:
+        """Polar inertia about the mass centre (kg m^2); inf with the spin held."""
+        return self._J
+
+    @property
+    def spin_is_state(self) -> bool:
+        """The spin speed is a state (J finite) or a held input (J = inf)."""
+        return self._J != INF
+
+    @property
+    def Omega(self) -> float:
+        """Spin speed (rad/s): the state, or the last held input."""
+        return self._inputs[0]
+
+    @property
+    def contact_pair(self) -> ContactPair:
+        """The rotor (``bodies.rotor.RigidRotor`` with this J; inf: the held spin) and the
+        bearing it touches (the chapter's ``bodies.bearing.FixedRigidBearing``): gap,
+        normal, speeds, W, impact law."""
+        p, J = self._p, self._J
+        key = self._pair_of
+        if key is None or key[0] is not p or key[1] != J:
+            self._pair = ContactPair(RigidRotor(p.m, J, p.e_c, p.phi, p.R),
+                                     FixedRigidBearing(c_r=p.c_r))
+            self._pair_of = (p, J)
+        assert self._pair is not None
+        return self._pair
+
     def set_params(self, params: RotorParams) -> None:
-        """Change parameters (tunables); takes effect from the next step."""
+        """Change parameters (tunables); takes effect from the next step (the spin, held
+        or a state, is kept)."""
         if params.c_r != self._p.c_r:
             raise ParameterError("c_r is fixed after initialisation; it cannot change mid-run")
+        if self._J != INF:
+            check_well_posed(params, self._J)
         self._p = params
         self._set_inputs(*self._inputs)  # rebuilds the models; forgets the proof and the lock
 
@@ -273,13 +347,20 @@ class TouchdownCore(FlightSteps, ContactSteps):
 
     # ------------------------------------------------------------------ stepping
 
-    def step(self, h: float, Omega: float, F_ext: complex = 0j, amb_on: float = 1.0,
-             budget: int | None = None) -> StepReport:
-        """Advance by h seconds with Omega (rad/s), F_ext (N) and amb_on held.
+    def step(self, h: float, Omega: float | None = None, F_ext: complex = 0j,
+             amb_on: float = 1.0, budget: int | None = None, *,
+             T_drive: float = 0.0) -> StepReport:
+        """Advance by h seconds with F_ext (N) and amb_on held, and Omega (rad/s) held with
+        the spin held, or T_drive (N m) held with the spin a state (Omega is then ignored;
+        a drive torque on a held spin is refused, InputError).
 
         The step's work is bounded by ``budget`` work units (default and at most WORK_MAX).
         A step that would need more stops where it is with STATUS_WORK_CAP and a message
         saying where (docs/model.md 7)."""
+        if self._J != INF:
+            return self._spin_step(h, F_ext, amb_on, budget, T_drive)
+        if T_drive or Omega is None:
+            self._reject_held_spin_inputs(Omega, T_drive)
         F = complex(F_ext)
         if (Omega, F, amb_on) != self._inputs:  # new held inputs (NaN never equals)
             if not (math.isfinite(Omega) and 0.0 <= amb_on <= 1.0
@@ -330,7 +411,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
                 if self._mode != mode:
                     rep.transitions.append((t0 + s, _MODE_NAMES[self._mode]))
         except (WorkCapExceeded, ContactWorkExceeded) as exc:
-            spin = " with the spin as a state" if self.SPIN_STATE else ""
+            spin = " with the spin as a state" if self._J != INF else ""
             stop_at_work_bound(rep, st, exc, t0, s, h, (
                 f"{_SEGMENT_NAMES[self._mode]}{spin} (segment {work.segs // SEGMENT_WORK}, "
                 f"{len(rep.impacts)} impacts in the step)"))
@@ -348,6 +429,16 @@ class TouchdownCore(FlightSteps, ContactSteps):
         self._t = t
         if tallied:
             self._fill_report(rep, self._t - t0 if s < h else h)
+
+    @staticmethod
+    def _reject_held_spin_inputs(Omega: float | None, T_drive: float) -> None:
+        """Raise the InputError of a held-spin step given no Omega or a drive torque."""
+        if Omega is None:
+            raise InputError("Omega is missing: the spin is held (J = inf), so each step "
+                             "needs the spin speed Omega (rad/s)")
+        raise InputError(f"T_drive = {T_drive!r} N m: the spin is held (J = inf), a drive "
+                         f"torque has no effect on it; make the spin a state (J finite) "
+                         f"or pass T_drive = 0")
 
     @staticmethod
     def _reject_inputs(h: float, Omega: float, F: complex, amb_on: float) -> None:
@@ -455,7 +546,10 @@ class TouchdownCore(FlightSteps, ContactSteps):
 
     @property
     def wall_forces(self) -> WallForces:
-        """The contact-free forces at the wall under the held inputs (per unit m c_r)."""
+        """The contact-free forces at the wall under the last inputs and the spin speed now
+        (per unit m c_r)."""
+        if self._J != INF:  # the spin moves within a step: built for the speed now
+            return WallForces.build(self._p, *self._inputs)
         return self._wf
 
     @property
@@ -469,7 +563,7 @@ class TouchdownCore(FlightSteps, ContactSteps):
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
             imb_h=(self._imb_seen_h, self._imb_free_h),
             Omega=self._inputs[0], F_ext=self._inputs[1], amb_on=self._inputs[2],
-            bearing=fixed_bearing_record(),
+            bearing=fixed_bearing_record(), J=None if self._J == INF else self._J,
         )
 
     def get_state(self) -> dict:
@@ -481,17 +575,22 @@ class TouchdownCore(FlightSteps, ContactSteps):
         """Restore a state produced by get_state (same or compatible version), or a
         CoreState; ParameterError for another schema or version (nothing changes)."""
         cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
-        if (cs.J is not None) != self.SPIN_STATE:
+        spin = self._J != INF
+        if (cs.J is not None) != spin:
             raise ParameterError(
                 "the state is of a core whose spin is "
                 f"{'a state (J set)' if cs.J is not None else 'held (no J)'}; this core's "
-                f"spin is {'a state' if self.SPIN_STATE else 'held'}: restore it into a "
+                f"spin is {'a state' if spin else 'held'}: restore it into a "
                 f"{'SpinCore' if cs.J is not None else 'TouchdownCore'} (rotortd.restore_core)")
+        if cs.J is not None:
+            check_well_posed(cs.params, cs.J)
         if dict(cs.bearing) != fixed_bearing_record():
             raise ParameterError(
                 f"the state's bearing record {dict(cs.bearing)!r} is not of this core's "
                 f"bearing {fixed_bearing_record()!r} (bearing.FixedRigidBearing)")
         self._p = cs.params
+        if cs.J is not None:
+            self._J = cs.J
         self._t, self._t_lo = cs.t, cs.t_lo
         self._z, self._v = cs.z, cs.v
         self._psi, self._turns = cs.psi, cs.turns
@@ -509,3 +608,34 @@ class TouchdownCore(FlightSteps, ContactSteps):
         if not math.isnan(cs.imb_h[1]):  # (its coefficients: the same bits again)
             c = self._fm.imb_impulse(cs.imb_h[1])
             self._imb_free_h, self._imb_free = cs.imb_h[1], (c.bz, c.bv, c.b0, c.bE.imag)
+
+
+class SpinCore(TouchdownCore):
+    """``TouchdownCore`` with the spin as a state: J (kg m^2, finite, > 0) required. It adds
+    no physics and no state of its own (the one core; ``TouchdownCore(params, J=J)`` is
+    the same model); the name says which rotor a caller built."""
+
+    def __init__(self, params: RotorParams, J: float, *, z0: complex = 0j,
+                 v0: complex = 0j, psi0: float = 0.0, Omega0: float = 0.0,
+                 t0: float = 0.0) -> None:
+        check_range("J", J, 0.0, lo_open=True, unit="kg m^2")  # (finite: check_finite)
+        super().__init__(params, J=J, z0=z0, v0=v0, psi0=psi0, Omega0=Omega0, t0=t0)
+
+    @classmethod
+    def on_steady_whirl(cls, params: RotorParams, Omega: float, *, F_ext: complex = 0j,
+                        amb_on: float = 1.0, psi0: float = 0.0, t0: float = 0.0,
+                        J: float = INF) -> SpinCore:
+        """Start on the held-spin steady whirl at Omega (rad/s) with the spin a state
+        (TouchdownCore.on_steady_whirl; J required)."""
+        core = TouchdownCore.on_steady_whirl(params, Omega, F_ext=F_ext, amb_on=amb_on,
+                                             psi0=psi0, t0=t0)
+        return cls(params, J, z0=core.z, v0=core.v, psi0=psi0, Omega0=Omega, t0=t0)
+
+
+def restore_core(st: dict | CoreState) -> TouchdownCore:
+    """A core restored from a state record or its JSON: a SpinCore when the state has J,
+    else a TouchdownCore (ParameterError for an unreadable state)."""
+    cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
+    core = TouchdownCore(cs.params) if cs.J is None else SpinCore(cs.params, cs.J)
+    core.set_state(cs)
+    return core

@@ -56,7 +56,7 @@ def run_attractor(
     Omega = OMEGA. RuntimeError when a step stops at the core's work cap.
     """
     p = si_params(chapter_params(gamma=gamma))
-    core = TouchdownCore.from_scaled(p, OMEGA, U0, dU0)
+    core = TouchdownCore.from_scaled(p, OMEGA, U0=U0, dU0=dU0)
     n = round(t_end / dt)
     n_tr = next((k for k in range(n) if (k + 1) * dt > t_rec), n)
     rec, message = run_to_attractor(core, OMEGA, dt / OMEGA, n_tr, n - n_tr)

@@ -117,11 +117,11 @@ class Cycle:
 
     def core(self) -> TouchdownCore:
         """A TouchdownCore started right after the cycle's impact (psi0 = 0, t0 = 0)."""
-        return TouchdownCore(self.params, self.z0, self.v0, 0.0)
+        return TouchdownCore(self.params, z0=self.z0, v0=self.v0, psi0=0.0)
 
     def core_from_scaled(self) -> TouchdownCore:
         """The same start through ``TouchdownCore.from_scaled`` (U0, dU0, psi0 = 0)."""
-        return TouchdownCore.from_scaled(self.params, OMEGA, self.U0, self.dU0, 0.0)
+        return TouchdownCore.from_scaled(self.params, OMEGA, U0=self.U0, dU0=self.dU0, psi0=0.0)
 
 
 def multipliers_of(J: np.ndarray) -> np.ndarray:

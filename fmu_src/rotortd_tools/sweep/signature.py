@@ -72,7 +72,7 @@ def simulate_drop(core: TouchdownCore, Omega: float, settings: Settings,
 
 def _spin(core: TouchdownCore, Omega: float) -> float:
     """The core's spin (rad/s): its state for a SpinCore, else the held Omega."""
-    return float(core.Omega) if core.SPIN_STATE else Omega  # type: ignore[attr-defined]
+    return float(core.Omega) if core.spin_is_state else Omega  # type: ignore[attr-defined]
 
 
 def signature(rec: Recorder, core: TouchdownCore, Omega: float, t_rec: float,

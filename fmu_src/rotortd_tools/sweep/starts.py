@@ -48,7 +48,7 @@ def make_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams,
     core = _held_start(label, p, Omega, sp)
     if J is None:
         return core
-    return SpinCore(core.params, J, core.z, core.v, core.psi, Omega, core.t)
+    return SpinCore(core.params, J, z0=core.z, v0=core.v, psi0=core.psi, Omega0=Omega, t0=core.t)
 
 
 def _held_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams
@@ -69,7 +69,7 @@ def _held_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams
             raise NoStart(str(exc)) from None
     if head == "large":
         U0 = 0.9 * U_star / abs(U_star) if abs(U_star) > 0 else 0.9 + 0j
-        return TouchdownCore(p, p.c_r * U0, 0j)
+        return TouchdownCore(p, z0=p.c_r * U0, v0=0j)
     if head == "cycle":
         return _cycle_start(p, Omega, sp, branch)
     raise SweepError(f"unknown start {label!r}")
@@ -83,7 +83,7 @@ def _cycle_start(p: RotorParams, Omega: float, sp: ScaledParams, branch: str) ->
         cyc = find(sp.gamma, **kwargs, **overrides)
     except (KeyError, RuntimeError, ValueError, ArithmeticError) as exc:
         raise NoStart(f"no period-one cycle: {type(exc).__name__}: {exc}") from None
-    return TouchdownCore.from_scaled(p, Omega, complex(cyc.U0), complex(cyc.dU0))
+    return TouchdownCore.from_scaled(p, Omega, U0=complex(cyc.U0), dU0=complex(cyc.dU0))
 
 
 

@@ -1,20 +1,20 @@
-"""The rotor with its spin as a state (docs/model.md §8): ``SpinCore``.
+"""The segments of a rotor whose spin is a state (docs/model.md §8): ``SpinSteps``.
 
-Frame and units: inertial, SI. A ``SpinCore`` is a ``TouchdownCore`` whose spin speed Omega
-is a state instead of a held input: translation and spin are solved together as one rigid
-body (J the polar inertia about the mass centre), with the drive torque T_drive, the
-external force F_ext and amb_on held over a step. It shares the core's state layout, its
-views (kinematics, counters) and its serialisation (``CoreState`` with ``J`` set, the held
-Omega in ``inputs`` being the spin state), and replaces the step:
+Frame and units: inertial, SI. One core, ``simulator.TouchdownCore``, carries both rotors:
+its spin held (J = inf; Omega an input of each step) or a state (J finite; the drive
+torque T_drive held over a step). With the spin a state, translation and spin are solved
+together as one rigid body (J the polar inertia about the mass centre), with T_drive,
+F_ext and amb_on held; the core binds these segment choices in place of the held-spin ones
+(``TouchdownCore._bind_rotor``), inside the same step loop (``TouchdownCore._segments``):
 
-    free flight (spin_flight.SpinFlight: closed form with the bearing off and no external
-    force, else integrated; rigorous contact search)
-    -> impacts (rigid.spin_impact: Newton + Coulomb through the Delassus matrix, capped so
-       that no impact creates energy)
-    -> sustained contact (spin_contact.SpinContact: sliding or rolling about the contact
-       point) -> lift-off -> free flight.
+    free flight (segments.spin_flight.SpinFlight: closed form with the bearing off and no
+    external force, else integrated; rigorous contact search)
+    -> impacts (the contact pair's law, contact.pair.ContactPair.impact: Newton + Coulomb
+       through the Delassus matrix, capped so that no impact creates energy)
+    -> sustained contact (segments.spin_contact.SpinContact: sliding or rolling about the
+       contact point) -> lift-off -> free flight.
 
-The low-speed rule that turns an impact into contact is the held-speed core's
+The low-speed rule that turns an impact into contact is the one rule
 (``flight_step.starts_contact``) with the restitution the impact used.
 """
 
@@ -22,16 +22,12 @@ from __future__ import annotations
 
 import cmath
 import math
-from dataclasses import replace
 
-from ..bodies.bearing import FixedRigidBearing
-from ..bodies.rotor import RigidRotor, check_well_posed
 from ..contact.events import Event
 from ..contact.impact import Impact
-from ..contact.pair import ContactPair
 from ..contact.search import WORK_MAX
 from ..contact.wall import SegmentEnd
-from ..params import InputError, RotorParams, check_finite, check_range
+from ..params import InputError, check_finite
 from ..segments.spin_contact import (
     ContactForces,
     ContactModel,
@@ -49,84 +45,16 @@ from .report import (
     StepContext,
     StepReport,
 )
-from .simulator import TouchdownCore
-from .state import CoreState
 
 
-class SpinCore(TouchdownCore):
-    """Rotor in a touchdown bearing with the spin as a state (module docstring).
-
-    J (kg m^2) is the polar inertia about the mass centre; Omega0 (rad/s) the initial spin.
-    Raises CrossParameterError when J is too small for the contact to be well posed."""
-
-    SPIN_STATE = True
-    _pair: ContactPair | None = None  # the contact pair, built for _pair_of (params, J)
-    _pair_of: tuple[RotorParams, float] | None = None
-
-    def __init__(self, params: RotorParams, J: float, z0: complex = 0j, v0: complex = 0j,
-                 psi0: float = 0.0, Omega0: float = 0.0, t0: float = 0.0) -> None:
-        super().__init__(params, z0, v0, psi0, t0)
-        self._J = check_range("J", J, 0.0, lo_open=True, unit="kg m^2")
-        check_well_posed(params, self._J)
-        self._inputs = (check_finite("Omega0", Omega0), 0j, 1.0)
-
-    @classmethod
-    def on_steady_whirl(cls, params: RotorParams, Omega: float, F_ext: complex = 0j,
-                        amb_on: float = 1.0, psi0: float = 0.0, t0: float = 0.0,
-                        *, J: float = math.inf) -> SpinCore:
-        """Start on the held-speed steady whirl at Omega (rad/s) (TouchdownCore's)."""
-        held = TouchdownCore.on_steady_whirl(params, Omega, F_ext, amb_on, psi0, t0)
-        return cls(params, J, held.z, held.v, psi0, Omega, t0)
-
-    @property
-    def J(self) -> float:
-        """Polar inertia about the mass centre (kg m^2)."""
-        return self._J
-
-    @property
-    def Omega(self) -> float:
-        """Spin speed (rad/s), a state."""
-        return self._inputs[0]
-
-    @property
-    def contact_pair(self) -> ContactPair:
-        """The rotor (``rigid.RigidRotor`` with this J) and the bearing it touches (the
-        chapter's ``bearing.FixedRigidBearing``): gap, normal, speeds, W, impact law."""
-        p, J = self._p, self._J
-        key = self._pair_of
-        if key is None or key[0] is not p or key[1] != J:
-            self._pair = ContactPair(RigidRotor(p.m, J, p.e_c, p.phi, p.R),
-                                     FixedRigidBearing(c_r=p.c_r))
-            self._pair_of = (p, J)
-        assert self._pair is not None
-        return self._pair
-
-    def set_params(self, params: RotorParams) -> None:
-        """Change parameters between steps (tunables); the spin is kept."""
-        check_well_posed(params, self._J)
-        W = self._inputs[0]
-        super().set_params(params)
-        self._inputs = (W, *self._inputs[1:])
-
-    @property
-    def state(self) -> CoreState:
-        """The state as a plain record, with J set (read-only)."""
-        return replace(super().state, J=self._J)
-
-    def set_state(self, st: dict | CoreState) -> None:
-        """Restore a state of a SpinCore (J set); ParameterError otherwise, nothing
-        changes."""
-        cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
-        if cs.J is not None:
-            check_well_posed(cs.params, cs.J)
-        super().set_state(cs)
-        self._J = cs.J
+class SpinSteps:
+    """The segments of the rotor whose spin is a state (mixin of ``simulator.TouchdownCore``,
+    bound in place of the held-spin ones when J is finite: ``TouchdownCore._bind_rotor``)."""
 
     # ------------------------------------------------------------------ stepping
 
-    def step(self, h: float, Omega: float | None = None, F_ext: complex = 0j,
-             amb_on: float = 1.0, budget: int | None = None, *,
-             T_drive: float = 0.0) -> StepReport:
+    def _spin_step(self, h: float, F_ext: complex, amb_on: float, budget: int | None,
+                   T_drive: float) -> StepReport:
         """Advance by h (s) with T_drive (N m), F_ext (N) and amb_on held; ``Omega`` is
         ignored (the spin is a state). Work bound as TouchdownCore.step."""
         F = complex(F_ext)
@@ -145,10 +73,10 @@ class SpinCore(TouchdownCore):
         st.held = held
         s = self._segments(h, t0, rep, st)
         self._finish(rep, t0, s, h, True)
-        self._imbalance_torque(rep, W0, held.T_drive, h if s >= h else self._t - t0)
+        self._spin_imbalance_torque(rep, W0, held.T_drive, h if s >= h else self._t - t0)
         return rep
 
-    def _imbalance_torque(self, rep: StepReport, W0: float, T_drive: float,
+    def _spin_imbalance_torque(self, rep: StepReport, W0: float, T_drive: float,
                           span: float) -> None:
         """The imbalance reaction torque e_c Im(conj(F_amb + F_ext + F_c) E) over the step
         (docs/model.md 9), from the spin's balance J dOmega = int (T_drive + T_f + T_imb):
@@ -164,7 +92,7 @@ class SpinCore(TouchdownCore):
 
     # ------------------------------------------------------------------ flight and impacts
 
-    def _advance_free(self, s: float, h: float, t0: float, rep: StepReport,
+    def _spin_advance_free(self, s: float, h: float, t0: float, rep: StepReport,
                       st: StepContext) -> float:
         """A free-flight segment from s (s) into the step (``SpinFlight``); an impact or
         contact at its end."""
@@ -174,16 +102,16 @@ class SpinCore(TouchdownCore):
                          self._v, self._psi, self._inputs[0]).run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         self._z, self._v = end.z, end.v
-        self._advance_spin(end)
+        self._spin_advance_spin(end)
         if end.event is None:
             return h
         s_wall = st.later(s, min(end.duration, rem))
         sticky = s_wall == s == st.sticky_at  # a second zero-length flight here
-        if not self._at_wall(t0 + s_wall + st.s_lo, held, rep, st, sticky):
+        if not self._spin_at_wall(t0 + s_wall + st.s_lo, held, rep, st, sticky):
             st.sticky_at = s_wall  # touched, but no contact force: flight again
         return s_wall
 
-    def _advance_spin(self, end: SegmentEnd) -> None:
+    def _spin_advance_spin(self, end: SegmentEnd) -> None:
         """The spin at a segment's end: its angle and speed, states of the segment."""
         self._set_psi(end.psi)
         self._set_spin(end.Omega)
@@ -191,7 +119,7 @@ class SpinCore(TouchdownCore):
     def _set_spin(self, W: float) -> None:
         self._inputs = (W, *self._inputs[1:])
 
-    def _at_wall(self, t: float, held: HeldInputs, rep: StepReport, st: StepContext,
+    def _spin_at_wall(self, t: float, held: HeldInputs, rep: StepReport, st: StepContext,
                  sticky: bool) -> bool:
         """The flight reached the wall at t (s): an impact if it moves outward, then
         contact if the low-speed rule says so or it touched with zero normal speed. False
@@ -249,7 +177,7 @@ class SpinCore(TouchdownCore):
 
     # ------------------------------------------------------------------ contact
 
-    def _contact_forces(self, held: HeldInputs, s: float) -> ContactForces:
+    def _spin_contact_forces(self, held: HeldInputs, s: float) -> ContactForces:
         W = self._inputs[0]
         if s == 0.0:
             return rolling_forces(held, self._theta, self._psi, W)
@@ -267,7 +195,7 @@ class SpinCore(TouchdownCore):
         self._dtheta = (n.conjugate() * v).imag / p.c_r
         slack = (ContactModel(held).normal_tol(self._theta, self._dtheta, self._psi,
                                                self._inputs[0]) if sticky else 0.0)
-        mode, s = self._contact_mode(held, p.R * self._inputs[0] + p.c_r * self._dtheta,
+        mode, s = self._spin_contact_mode(held, p.R * self._inputs[0] + p.c_r * self._dtheta,
                                      -slack)
         if mode == MODE_FREE:
             self._on_wall = True
@@ -276,13 +204,13 @@ class SpinCore(TouchdownCore):
         st.n_slack = slack
         return True
 
-    def _contact_mode(self, held: HeldInputs, vrel: float, n_min: float = 0.0
+    def _spin_contact_mode(self, held: HeldInputs, vrel: float, n_min: float = 0.0
                       ) -> tuple[int, float]:
         """(mode, slip sign) of the contact at the current (theta, theta', psi, Omega);
         MODE_FREE when the normal force is not above n_min (N)."""
         p = self._p
         if vrel == 0.0:
-            f = self._contact_forces(held, 0.0)
+            f = self._spin_contact_forces(held, 0.0)
             if n_min >= f.N:
                 return MODE_FREE, 0.0
             if abs(f.F_t) <= p.mu * f.N:
@@ -290,10 +218,10 @@ class SpinCore(TouchdownCore):
             s = 1.0 if f.F_t > 0.0 else -1.0
         else:
             s = 1.0 if vrel > 0.0 else -1.0
-        f = self._contact_forces(held, s)
+        f = self._spin_contact_forces(held, s)
         return (MODE_SLIDING, s) if n_min < f.N else (MODE_FREE, 0.0)
 
-    def _advance_contact(self, s: float, h: float, rep: StepReport, st: StepContext
+    def _spin_advance_contact(self, s: float, h: float, rep: StepReport, st: StepContext
                          ) -> float:
         """A contact segment from s (s) into the step (``SpinContact``); the transition at
         its end."""
@@ -308,7 +236,7 @@ class SpinCore(TouchdownCore):
         self._end_segment(end, rep, st, 1.0 + 0j)  # (I_z = 0: T_imb from the spin balance)
         return st.later(s, end.duration) if end.duration < rem else h
 
-    def _transition(self, event: Event | None, st: StepContext | None) -> None:
+    def _spin_transition(self, event: Event | None, st: StepContext | None) -> None:
         """Apply a contact segment's event: lift-off to flight, or a new contact mode."""
         if event is None:
             return
@@ -319,9 +247,9 @@ class SpinCore(TouchdownCore):
             return
         if event is Event.SLIP_ZERO:
             self._dtheta = -p.R * self._inputs[0] / p.c_r
-            mode, s = self._contact_mode(held, 0.0)
+            mode, s = self._spin_contact_mode(held, 0.0)
         else:  # slip_start: rolling can no longer hold
-            f = self._contact_forces(held, 0.0)
+            f = self._spin_contact_forces(held, 0.0)
             mode, s = MODE_SLIDING, (1.0 if f.F_t > 0.0 else -1.0)
         if mode == MODE_FREE:
             self._leave_wall()
@@ -333,12 +261,3 @@ class SpinCore(TouchdownCore):
         self._z, self._v = self._wall_state()
         self._mode = MODE_FREE
         self._on_wall = True
-
-
-def restore_core(st: dict | CoreState) -> TouchdownCore:
-    """A core restored from a state record or its JSON: a SpinCore when the state has J,
-    else a TouchdownCore (ParameterError for an unreadable state)."""
-    cs = st if isinstance(st, CoreState) else CoreState.from_json(st)
-    core = TouchdownCore(cs.params) if cs.J is None else SpinCore(cs.params, cs.J)
-    core.set_state(cs)
-    return core
