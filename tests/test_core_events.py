@@ -308,3 +308,32 @@ def test_bound_polynomials_match_their_nested_forms() -> None:
         assert min(fm.g3_poly + fm.g4_poly) >= 0.0
         assert abs(s0 + V * (s1 + V * s2) - G3) <= 16 * EPS * G3
         assert abs(q0 + V * (q1 + V * q2) - G4) <= 16 * EPS * G4
+
+
+def test_bracket_left_is_the_one_root_finder_inlined() -> None:
+    """The contact search's innermost loop (search._bracket_left) is the core's one root
+    finder (segments.roots.illinois) inlined: on random increasing cubics, on and off the
+    wall, both give the same left end, bit for bit."""
+    from rotortd.contact.search import BRACKET_RTOL, Work, _bracket_left
+    from rotortd.segments.roots import illinois
+
+    rng = random.Random(23)
+    checked = 0
+    for _ in range(3000):
+        g0 = None if rng.random() < 0.3 else -rng.uniform(1e-3, 1.0)
+        g1, g2, g3 = (rng.uniform(0.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-1.0, 1.0))
+        lo, hi = 0.0, rng.uniform(0.01, 3.0)
+
+        def f(u: float, g0: float | None = g0, g1: float = g1, g2: float = g2,
+              g3: float = g3) -> float:
+            q = g1 + u * (0.5 * g2 + u * g3 / 6.0)
+            return q if g0 is None else g0 + u * q
+
+        if not f(lo) < 0.0 <= f(hi):
+            continue
+        checked += 1
+        left = _bracket_left((g0, g1, g2, g3), lo, hi, Work())
+        ref, _, _ = illinois(lambda u: (-f(u), None), lo, -f(lo), hi, -f(hi), None,
+                             lambda a, b, _: b - a <= BRACKET_RTOL * b, 100)
+        assert left == ref, (g0, g1, g2, g3, hi)
+    assert checked > 1000

@@ -248,8 +248,10 @@ def _bracket_left(
 ) -> float:
     """Shrink [lo, hi] by Illinois; return the left end. ``coeffs`` = (g0, g1, g2, g3): the
     function is p(u) = g0 + u q(u), q(u) = g1 + u (g2/2 + u g3/6), or q itself when g0 is
-    None (on the wall); it is increasing on [lo, hi] with f(lo) < 0 <= f(hi). Evaluated
-    inline (the same expressions as _cubic): this loop is the search's innermost one."""
+    None (on the wall); it is increasing on [lo, hi] with f(lo) < 0 <= f(hi). A declared
+    accelerator: the one root finder (``segments.roots.illinois`` on -f) inlined, as this
+    loop is the search's innermost one, with p evaluated inline (the same expressions as
+    _cubic); tests/test_core_events.py checks that the two give the same bits."""
     g0, g1, g2, g3 = coeffs
     c2 = 0.5 * g2
     flo = g1 + lo * (c2 + lo * g3 / 6.0)

@@ -17,6 +17,7 @@ from ..contact.events import Event
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces
 from . import gbs
+from .roots import illinois
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""
@@ -318,25 +319,9 @@ class Sliding:
                 kind = self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
                 stuck = kind is Event.SLIP_ZERO and abs(sv0) <= noise * s_v
                 return H * 2.0**-40, y_x, Event.SLIP_STUCK if stuck else kind
-        hi, y_best = H, y_hi
-        side = 0
-        for _ in range(100):
-            if hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300:
-                break
-            x = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
-            if not lo < x < hi:
-                x = 0.5 * (lo + hi)
-            yx, fx = at(x)
-            if fx > noise:
-                lo, flo = x, fx
-                if side == -1:
-                    fhi *= 0.5
-                side = -1
-            else:
-                hi, fhi, y_best = x, fx, yx
-                if side == 1:
-                    flo *= 0.5
-                side = 1
+        _, hi, y_best = illinois(
+            lambda x: at(x)[::-1], lo, flo, H, fhi, y_hi,
+            lambda lo, hi, _: hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300, 100, noise)
         return hi, y_best, self._kind(y_best, u + hi, s_n, s_v)
 
     def _kind(self, y: list[float], u: float, s_n: float, s_v: float) -> Event:

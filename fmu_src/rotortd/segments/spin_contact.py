@@ -40,6 +40,7 @@ from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
 from . import gbs
+from .roots import illinois
 
 RTOL = 1e-13
 """Relative tolerance per extrapolated step, every component."""
@@ -295,28 +296,13 @@ class SpinContact:
             work += RHS_WORK * nfev + STEP_WORK
             return yt, self._margin(yt)
 
-        a, fa = 0.0, self._margin(y)
+        fa = self._margin(y)
         yb, fb = at(b)
         if fb > 0.0:
             return None
-        side = 0
-        for _ in range(ROOT_ITERS):
-            if b - a <= 4.0 * math.ulp(u + b) or fb == 0.0:
-                break
-            c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
-            if not a < c < b:
-                c = 0.5 * (a + b)
-            yc, fc = at(c)
-            if fc > 0.0:
-                a, fa = c, fc
-                if side == 1:
-                    fb *= 0.5
-                side = 1
-            else:
-                b, yb, fb = c, yc, fc
-                if side == -1:
-                    fa *= 0.5
-                side = -1
+        _, b, yb = illinois(lambda x: at(x)[::-1], 0.0, fa, b, fb, yb,
+                            lambda a, b, fb: b - a <= 4.0 * math.ulp(u + b) or fb == 0.0,
+                            ROOT_ITERS)
         return b, yb, work
 
     def _end(self, u: float, y: Vector, event: str | None, N_peak: float, work: int,
