@@ -119,6 +119,13 @@ class RotorParams:
         """AMB bias force F_bias, N, inertial frame: i m g when levitating, else 0."""
         return 1j * self.m * self.g if self.levitate else 0j
 
+    def amb_force(self, a: float, z: complex, v: complex) -> complex:
+        """The AMB force on the rotor centre at (z (m), v (m/s)), N, inertial: the one
+        definition a (F_bias - c v - k z), a = amb_on in [0, 1]. The integrators' kernels
+        expand it in their own variables (segments.spin_flight, segments.spin_contact,
+        segments.flight, contact.wall)."""
+        return a * (self.bias_force - self.c * v - self.k * z)
+
     @property
     def gravity_force(self) -> complex:
         """Gravity on the rotor, N, inertial frame: -i m g."""

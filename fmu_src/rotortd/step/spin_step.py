@@ -169,7 +169,7 @@ class SpinSteps:
         from (z, v) with spin W (rad/s)."""
         p = self._p
         E = cmath.exp(1j * (self._psi + p.phi))
-        F = held.a * (p.bias_force - p.c * v - p.k * z) + held.F_ext
+        F = p.amb_force(held.a, z, v) + held.F_ext
         zdd, _ = free_acceleration(F, p.m, p.g, p.e_c, self._J, held.T_drive, W, E)
         n = z / abs(z)
         w = n.conjugate() * v
