@@ -12,7 +12,8 @@ contact begins when
   (1) h_b <= ETA_HEIGHT c_r (the remaining chattering cascade is below resolution), or
   (2) the cascade to (1) would need more than N_CASCADE further impacts (d close to 1,
       or d = 1 where it never ends) and the bounce is short, tau_b <= ETA_TIME/w_ref,
-      w_ref = max(|Omega|, |theta'|, sqrt(kappa), beta, sqrt(A/c_r)).
+      w_ref = max(|Omega|, |theta'|, sqrt(kappa), beta, sqrt(|q0| + |eu|), sqrt(A/c_r))
+      (``reference_rate``, theta' of the rebound; docs/model.md §6).
 
 Rule (1) replaces a cascade with total normal momentum m(1+d)v/(1-d) by a plastic impact
 m v plus sliding, which delivers the rest in the accumulation time 2 d v/((1-d) A): the
@@ -32,7 +33,7 @@ from collections.abc import Callable
 from ..contact.events import Event
 from ..contact.impact import Impact, reset
 from ..contact.search import WORK_MAX, ContactLocator, Work, flight_is_clear
-from ..contact.wall import SegmentEnd
+from ..contact.wall import SegmentEnd, WallForces
 from ..scaled import TWO_PI_HI, TWO_PI_LO
 from ..segments.flight import FlightModel
 from .report import StepContext, StepReport
@@ -225,12 +226,9 @@ class FlightSteps:
         """The low-speed rule of the module docstring: does this impact start contact?"""
         p = self._p
 
-        def w_ref() -> float:
-            vt = (n.conjugate() * v_plus).imag
-            return max(self._wf.omega_ref(vt / p.c_r), math.sqrt(A / p.c_r))
-
         A = self._outward_accel(n, v_plus)
-        return starts_contact(A, p.d * v, p.d, p.c_r, w_ref)
+        return starts_contact(A, p.d * v, p.d, p.c_r, lambda: reference_rate(
+            self._wf, (n.conjugate() * v_plus).imag / p.c_r, A, p.c_r))
 
 
 class Flight:
@@ -266,6 +264,14 @@ class Flight:
             work.evals += 1
             z, v = fm.propagate(self.z0, self.v0, self.E, rem, cache=not self.resumed)
         return SegmentEnd(rem, NAN, NAN, None, None, INF, z, v, NAN, NAN, work.total)
+
+
+def reference_rate(wf: WallForces, dtheta: float, A: float, c_r: float) -> float:
+    """Rule (2)'s reference rate w_ref (rad/s) of the module docstring, for both spin
+    models: the largest rate of the wall forces ``wf`` (WallForces.omega_ref: |Omega|,
+    |theta'|, sqrt(kappa), beta, sqrt(|q0| + |eu|)) at the rebound's whirl rate dtheta
+    (rad/s), and sqrt(A/c_r) of the outward acceleration A (m/s^2)."""
+    return max(wf.omega_ref(dtheta), math.sqrt(A / c_r))
 
 
 def starts_contact(A: float, vb: float, d: float, c_r: float,

@@ -26,7 +26,7 @@ import math
 from ..contact.events import Event
 from ..contact.impact import Impact
 from ..contact.search import WORK_MAX
-from ..contact.wall import SegmentEnd
+from ..contact.wall import SegmentEnd, WallForces
 from ..params import InputError, check_finite
 from ..segments.spin_contact import (
     ContactForces,
@@ -37,7 +37,7 @@ from ..segments.spin_contact import (
     sliding_forces,
 )
 from ..segments.spin_flight import SpinFlight, free_acceleration
-from .flight_step import starts_contact
+from .flight_step import reference_rate, starts_contact
 from .report import (
     MODE_FREE,
     MODE_ROLLING,
@@ -147,9 +147,9 @@ class SpinSteps:
         v_minus = self._v
         v_plus = pair.rotor.velocity_after(v_minus, n, self._psi, r)
         A = self._outward_accel_spin(z, v_plus, W + r.dOmega, held)
-        vt = (n.conjugate() * (v_minus - pair.bearing.velocity())).imag  # relative, along i n
-        plastic = starts_contact(A, r.d_eff * rdot, r.d_eff, p.c_r,
-                                 lambda: max(abs(W), abs(vt) / p.c_r, math.sqrt(A / p.c_r)))
+        plastic = starts_contact(A, r.d_eff * rdot, r.d_eff, p.c_r, lambda: reference_rate(
+            WallForces.build(p, W + r.dOmega, held.F_ext, held.a),
+            (n.conjugate() * (v_plus - pair.bearing.velocity())).imag / p.c_r, A, p.c_r))
         if plastic:
             r = pair.impact(dl, p.mu, 0.0, rdot, vrel)
             v_plus = pair.rotor.velocity_after(v_minus, n, self._psi, r)
