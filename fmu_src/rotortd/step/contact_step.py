@@ -160,24 +160,40 @@ class ContactSteps:
         return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0
 
     def _transition(self, event: Event | None, st: StepContext | None) -> None:
-        wf = self._wf
+        """The mode machine, one for both spin models: apply a contact segment's event.
+        LIFT_OFF: to flight; SLIP_START: rolling gives way to sliding, with the slip sign
+        of the friction rolling needed; SLIP_ZERO: the slip is zero, roll or slide (or
+        leave the wall, with the spin a state) as the forces there say; SLIP_STUCK (held
+        spin): zero slip that sliding cannot leave rolls, the cone violations below
+        resolution ignored for the rest of the step. The forces at a state come from the
+        rotor's model (``_roll_or_slide``, ``_cone_sign``: bound by ``_bind_rotor``)."""
         if event is None:
             return
         if event is Event.LIFT_OFF:
             self._lift_off()
-        elif event is Event.SLIP_ZERO:
-            self._dtheta = -wf.wr
-            self._choose_contact_mode()
-            self._locked = False
-        elif event is Event.SLIP_STUCK:  # sliding cannot leave zero slip: it rolls, and
-            self._dtheta = -wf.wr  # cone violations below resolution are ignored this step
+            return
+        assert st is not None
+        self._locked = False
+        if event is Event.SLIP_START:
+            self._mode, self._slip = MODE_SLIDING, self._cone_sign(st)
+            return
+        p = self._p
+        self._dtheta = -p.R * self._inputs[0] / p.c_r  # (= -WallForces.wr, bit for bit)
+        if event is Event.SLIP_STUCK:
             self._mode = MODE_ROLLING
-            self._locked = False
-            assert st is not None
             st.roll_lenient = True
-        elif event is Event.SLIP_START:
-            _, gt = wf.gn_gt(self._theta, self._dtheta, self._phasor())
-            self._mode, self._slip = MODE_SLIDING, math.copysign(1.0, gt)
+        else:
+            self._roll_or_slide(st)
+
+    def _roll_or_slide(self, st: StepContext) -> None:
+        """At zero slip: rolling or sliding by the held spin's wall forces."""
+        self._choose_contact_mode()
+
+    def _cone_sign(self, st: StepContext) -> float:
+        """The slip sign when rolling leaves the friction cone: that of the static
+        friction rolling needed (held spin's wall forces)."""
+        _, gt = self._wf.gn_gt(self._theta, self._dtheta, self._phasor())
+        return math.copysign(1.0, gt)
 
     def _lift_off(self) -> None:
         self._z, self._v = self._wall_state()

@@ -139,7 +139,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         class's own (FlightSteps, ContactSteps); with the spin a state (J finite) the
         instance takes SpinSteps' in their place, for the same step loop."""
         held = self._J == INF
-        for name in ("_advance_free", "_advance_contact", "_advance_spin", "_transition"):
+        for name in ("_advance_free", "_advance_contact", "_advance_spin", "_roll_or_slide",
+                     "_cone_sign"):
             if held:
                 self.__dict__.pop(name, None)
             else:

@@ -23,7 +23,6 @@ from __future__ import annotations
 import cmath
 import math
 
-from ..contact.events import Event
 from ..contact.impact import Impact
 from ..contact.search import WORK_MAX
 from ..contact.wall import SegmentEnd, WallForces
@@ -236,28 +235,15 @@ class SpinSteps:
         self._end_segment(end, rep, st, 1.0 + 0j)  # (I_z = 0: T_imb from the spin balance)
         return st.later(s, end.duration) if end.duration < rem else h
 
-    def _spin_transition(self, event: Event | None, st: StepContext | None) -> None:
-        """Apply a contact segment's event: lift-off to flight, or a new contact mode."""
-        if event is None:
-            return
-        assert st is not None
-        held, p = st.held, self._p
-        if event is Event.LIFT_OFF:
-            self._leave_wall()
-            return
-        if event is Event.SLIP_ZERO:
-            self._dtheta = -p.R * self._inputs[0] / p.c_r
-            mode, s = self._spin_contact_mode(held, 0.0)
-        else:  # slip_start: rolling can no longer hold
-            f = self._spin_contact_forces(held, 0.0)
-            mode, s = MODE_SLIDING, (1.0 if f.F_t > 0.0 else -1.0)
+    def _spin_roll_or_slide(self, st: StepContext) -> None:
+        """At zero slip: rolling or sliding by the spin-state contact forces, or flight
+        when the normal force is not positive there."""
+        mode, s = self._spin_contact_mode(st.held, 0.0)
         if mode == MODE_FREE:
-            self._leave_wall()
+            self._lift_off()
         else:
             self._mode, self._slip = mode, s
 
-    def _leave_wall(self) -> None:
-        """Lift-off: the contact state becomes the flight state on the circle."""
-        self._z, self._v = self._wall_state()
-        self._mode = MODE_FREE
-        self._on_wall = True
+    def _spin_cone_sign(self, st: StepContext) -> float:
+        """The slip sign when rolling leaves the friction cone (spin-state forces)."""
+        return 1.0 if self._spin_contact_forces(st.held, 0.0).F_t > 0.0 else -1.0
