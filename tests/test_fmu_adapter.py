@@ -68,3 +68,28 @@ def test_state_document_is_plain_json() -> None:
     doc = json.loads(blob)
     assert doc["schema"] == "rotortd-fmu-state" and doc["core"]["schema"] == "rotortd-state"
     assert RotorTouchdown._fmu_state_from_bytes(blob) == state
+
+
+def test_state_outputs_are_published_by_name_from_the_table() -> None:
+    """Every field of the core's StateOutputs is shown by exactly one output of the variable
+    table (Var.shows), and after steps through impacts and contact each output holds the
+    core's value of its field, by name; a table that names a field the core does not
+    have is refused."""
+    from rotortd_fmi import touchdown as td
+    from rotortd_fmi import touchdown_variables as tv
+
+    slave = _slave(g=9.81, start_steady=True)
+    slave.amb_on = 0.0
+    t = 0.0
+    for _ in range(150):  # the drop: impacts, then contact
+        assert slave.do_step(t, 1e-3)
+        t += 1e-3
+    out = slave._core.outputs()
+    assert out.n_impacts > 10 and out.mode != 0
+    shows = {v.shows: v.name for v in tv.TABLE if v.shows}
+    assert sorted(shows) == sorted(out._fields)
+    for field, name in shows.items():
+        assert getattr(slave, name) == getattr(out, field), (name, field)
+    assert slave.in_contact == (out.mode != 0)
+    with pytest.raises(RuntimeError, match="the variable table shows"):
+        td.state_publisher((*out._fields, "omega_b"))

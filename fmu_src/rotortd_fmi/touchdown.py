@@ -54,6 +54,34 @@ STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core
 IMPACT_LOG_HEADER = "time,x,y,vx_minus,vy_minus,vx_plus,vy_plus,rdot,P_n,P_t,stick\n"
 
 
+ON_EVENTS = frozenset({"mode", "n_impacts", "t_last_impact", "v_last_impact", "E_diss"})
+"""The StateOutputs fields published only after a step with impacts or mode changes, or in
+contact (they change only then); in_contact follows mode."""
+_publishers: dict[tuple[str, ...], Any] = {}
+
+
+def state_publisher(fields: tuple[str, ...]) -> Any:
+    """``publish(adapter, values, events)``: assign the core's ``output_values`` (whose
+    order is ``fields``, the core's ``StateOutputs._fields``) to the outputs that show
+    them, by name from the variable table (``Var.shows``). Compiled once per field order
+    into one unpacking assignment: the doStep hot path pays no lookup. RuntimeError when
+    the table and the core do not name the same fields."""
+    if fields in _publishers:
+        return _publishers[fields]
+    by_field = {v.shows: v.name for v in tv.TABLE if v.shows}
+    if set(by_field) != set(fields) or len(by_field) != len(fields):
+        raise RuntimeError(f"the variable table shows {sorted(by_field)}, the core's state "
+                           f"outputs are {sorted(fields)}")
+    targets = ", ".join(f"_{f}" if f in ON_EVENTS else f"self.{by_field[f]}" for f in fields)
+    src = (f"def publish(self, out, events):\n    ({targets}) = out\n"
+           "    if events or _mode:\n        self.in_contact = _mode != 0\n"
+           + "".join(f"        self.{by_field[f]} = _{f}\n" for f in fields if f in ON_EVENTS))
+    namespace: dict[str, Any] = {}
+    exec(compile(src, "<rotortd_fmi.touchdown.state_publisher>", "exec"), namespace)
+    _publishers[fields] = namespace["publish"]
+    return namespace["publish"]
+
+
 class ModelError(ValueError):
     """A parameter, input or state problem detected by the adapter itself."""
 
@@ -130,6 +158,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._check_impact_log()
         try:
             self._core = self._make_core(rotortd)
+            self._publish = state_publisher(self._core.outputs()._fields)
         except rotortd.CrossParameterError as exc:
             raise ModelError(f"cross-parameter constraint: {exc}") from exc
         self._fixed_snapshot = self._fixed_values()
@@ -304,12 +333,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         only with ``events`` (impacts or mode changes in the step); E_diss also in a
         contact segment (mode != 0)."""
         out = self._core.output_values(omega, amb)
-        (self.x, self.y, self.vx, self.vy, self.r_rel, self.u_re, self.u_im, self.du_re,
-         self.du_im, self.psi, self.whirl_rate, self.v_rel, self.F_amb_x, self.F_amb_y,
-         self.Omega_out, mode, n_impacts, t_last, v_last, E_diss) = out
-        if events or mode:
-            self.mode, self.in_contact, self.n_impacts = mode, mode != 0, n_impacts
-            self.t_last_impact, self.v_last_impact, self.E_diss = t_last, v_last, E_diss
+        self._publish(self, out, events)  # (state_publisher: by name from the table)
         return sum(out)
 
     def _publish_step_outputs(self, rep: Any) -> float:
@@ -394,6 +418,8 @@ class RotorTouchdownAdapter(GuardedSlave):
         t0, failure = float(adapter["t0"]), str(adapter["failure"])
         fixed_snapshot = dict(adapter["fixed_snapshot"])
         self._core = core
+        if core is not None:
+            self._publish = state_publisher(core.outputs()._fields)
         for name, value in values.items():
             setattr(self, name, value)
         self._t0, self._failure, self._fixed_snapshot = t0, failure, fixed_snapshot

@@ -36,6 +36,9 @@ class Var:
     hi: float | None
     description: str
     tunable: bool = False
+    shows: str = ""
+    """An output that shows the state: the field of the core's ``StateOutputs`` it
+    publishes (``touchdown.publish_state`` is compiled from these); "" for the others."""
 
     @property
     def fmi_description(self) -> str:
@@ -63,10 +66,11 @@ def fixed(name: str, type_: str, start: Any, description: str) -> Var:
 
 
 def output(name: str, unit: str, description: str, lo: float | None = None,
-           hi: float | None = None, type_: str = "Real") -> Var:
-    """An output computed in doStep (initial exact)."""
+           hi: float | None = None, type_: str = "Real", *, shows: str = "") -> Var:
+    """An output computed in doStep (initial exact); ``shows``: the core's StateOutputs
+    field it publishes, if it shows the state."""
     start = {"Real": 0.0, "Integer": 0, "Boolean": False}[type_]
-    return Var(name, OUTPUT, type_, start, unit, lo, hi, description)
+    return Var(name, OUTPUT, type_, start, unit, lo, hi, description, shows=shows)
 
 
 def names(table: Iterable[Var], causality: str, *, tunable: bool | None = None) -> tuple:
