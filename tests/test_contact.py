@@ -231,7 +231,7 @@ def test_fused_sliding_sweep_is_the_generic_midpoint_rule(q0: complex, mu: float
     sliding integrator is the documented modified-midpoint extrapolation, only faster."""
     wf = WallForces(q0=q0, eu=2.1e5 * cmath.exp(0.7j), beta=36.8, kappa=3.4e4,
                     Omega=W0, wr=1.2e3, mu=mu)
-    sl = Sliding(wf, 0.83, 171.0, cmath.exp(2.2j), slip)
+    sl = Sliding(wf, theta0=0.83, dtheta0=171.0, E0=cmath.exp(2.2j), slip=slip)
     y0 = [0.83, 171.0, 0.4, -0.1, 0.2, 3.0, 0.5, -0.25]  # (theta, theta', I_n, J, I_e, Z)
     for nu in (0.0, 171.0, -30.0):  # the plain quadrature of the force, and by parts
         sl.nu = nu

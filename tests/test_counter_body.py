@@ -187,8 +187,10 @@ def test_search_finds_a_grazing_contact_with_a_moving_circle(excess: float) -> N
     nu = 200.0
     ring = OscillatingRing(c_r=p.c_r, A=p.c_r * (1.0 + excess), nu=nu)
     rem = 2.0 / nu  # past the turning point at pi/(2 nu)
-    end = SpinFlight(p, 0.04, 0.0, 0j, 0.0, 0j, 0j, 0.0, 0.0, bearing=ring).run(rem)
-    fixed = SpinFlight(p, 0.04, 0.0, 0j, 0.0, 0j, 0j, 0.0, 0.0).run(rem)
+    end = SpinFlight(p, 0.04, a=0.0, F_ext=0j, T_drive=0.0, z=0j, v=0j, psi=0.0, Omega=0.0,
+                     bearing=ring).run(rem)
+    fixed = SpinFlight(p, 0.04, a=0.0, F_ext=0j, T_drive=0.0, z=0j, v=0j, psi=0.0,
+                       Omega=0.0).run(rem)
     assert fixed.event is None and fixed.duration == rem
     if excess < 0.0:
         assert end.event is None and end.duration == rem
@@ -202,5 +204,6 @@ def test_search_finds_a_grazing_contact_with_a_moving_circle(excess: float) -> N
     assert abs(abs(end.z - c) - p.c_r) <= 4 * 2.2e-16 * p.c_r
     # the path's bounds are what makes the search rigorous: without them it steps past
     ring.path_bounds = lambda s, tau: (0.0, 0.0, 0.0, 0.0, 0.0)
-    blind = SpinFlight(p, 0.04, 0.0, 0j, 0.0, 0j, 0j, 0.0, 0.0, bearing=ring).run(rem)
+    blind = SpinFlight(p, 0.04, a=0.0, F_ext=0j, T_drive=0.0, z=0j, v=0j, psi=0.0, Omega=0.0,
+                       bearing=ring).run(rem)
     assert blind.event is None

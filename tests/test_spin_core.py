@@ -12,8 +12,15 @@ import json
 import math
 
 import pytest
-from rotortd import MODE_ROLLING, MODE_SLIDING, STATUS_OK, CrossParameterError, RotorParams
-from rotortd import SpinCore, restore_core
+from rotortd import (
+    MODE_ROLLING,
+    MODE_SLIDING,
+    STATUS_OK,
+    CrossParameterError,
+    RotorParams,
+    SpinCore,
+    restore_core,
+)
 
 CHAPTER_G = RotorParams(g=9.81)
 J_HALF = 0.5 * CHAPTER_G.m * CHAPTER_G.R ** 2  # 0.04 kg m^2
@@ -216,14 +223,14 @@ def test_one_core_for_both_rotors() -> None:
     assert one.n_impacts > 100 and one.mode == two.mode == MODE_ROLLING
     assert one.get_state() == two.get_state()
     held = TouchdownCore(CHAPTER_G)
-    assert not held.spin_is_state and held.J == math.inf
+    assert not held.spin_is_state and math.inf == held.J
     with pytest.raises(ParameterError, match="J"):
         SpinCore(CHAPTER_G, math.inf)
     with pytest.raises(TypeError):
         TouchdownCore(CHAPTER_G, 0j)  # type: ignore[misc]
     with pytest.raises(TypeError):
         SpinCore(CHAPTER_G, J_HALF, 0j)  # type: ignore[misc]
-    with pytest.raises(InputError, match="T_drive = 1.0 N m: the spin is held"):
+    with pytest.raises(InputError, match=r"T_drive = 1\.0 N m: the spin is held"):
         held.step(1e-3, 184.2, T_drive=1.0)
     with pytest.raises(InputError, match="Omega is missing"):
         held.step(1e-3)

@@ -43,8 +43,9 @@ class Scene:
     Om: float
 
     def flight(self, *, force: bool = False, p: RotorParams | None = None) -> SpinFlight:
-        return SpinFlight(p or self.p, self.J, self.a, self.F_ext, self.T, self.z, self.v,
-                          self.psi, self.Om, force_integration=force)
+        return SpinFlight(p or self.p, self.J, a=self.a, F_ext=self.F_ext, T_drive=self.T,
+                          z=self.z, v=self.v,
+                          psi=self.psi, Omega=self.Om, force_integration=force)
 
 
 # ------------------------------------------------------------------ mp references
@@ -327,18 +328,22 @@ def test_start_on_wall_inward_and_outward(a: float) -> None:
     z = p.c_r * cmath.exp(-0.6j)
     n = z / abs(z)
     # inward: no contact at duration 0, the flight goes on for a while
-    e = SpinFlight(p, J0, a, F, 0.0, z, -0.05 * n + 0.01j * n, 0.2, 184.2).run(1e-3, BIG)
+    e = SpinFlight(p, J0, a=a, F_ext=F, T_drive=0.0, z=z, v=-0.05 * n + 0.01j * n, psi=0.2,
+                   Omega=184.2).run(1e-3, BIG)
     assert e.duration > 1e-4
     # rdot = 0, acceleration outward (pushed down at the bottom, spin at rest): contact at 0
     zb = -1j * p.c_r
     q = p.replace(e_c=0.0)
-    e = SpinFlight(q, J0, a, F, 0.0, zb, 0.01 + 0j, 0.0, 0.0).run(1e-3, BIG)
+    e = SpinFlight(q, J0, a=a, F_ext=F, T_drive=0.0, z=zb, v=0.01 + 0j, psi=0.0,
+                   Omega=0.0).run(1e-3, BIG)
     assert e.event == "contact" and e.duration == 0.0
     # rdot = 0 at the top: the motion curves inward, a flight follows
-    e = SpinFlight(q, J0, a, F, 0.0, 1j * p.c_r, 0.01 + 0j, 0.0, 0.0).run(1e-3, BIG)
+    e = SpinFlight(q, J0, a=a, F_ext=F, T_drive=0.0, z=1j * p.c_r, v=0.01 + 0j, psi=0.0,
+                   Omega=0.0).run(1e-3, BIG)
     assert e.duration > 1e-4
     # on the wall moving outward: an impact at 0
-    e = SpinFlight(p, J0, a, F, 0.0, z, 0.05 * n, 0.2, 184.2).run(1e-3, BIG)
+    e = SpinFlight(p, J0, a=a, F_ext=F, T_drive=0.0, z=z, v=0.05 * n, psi=0.2,
+                   Omega=184.2).run(1e-3, BIG)
     assert e.event == "contact" and e.duration == 0.0 and e.z == z
 
 
@@ -397,7 +402,7 @@ def test_random_flights_invariants() -> None:
         Om = rng.choice([0.0, rng.uniform(-300, 300)])
         rem = 10 ** rng.uniform(-5, -2)
         psi = rng.uniform(-10, 10)
-        f = SpinFlight(p, J, a, F, T, z, v, psi, Om)
+        f = SpinFlight(p, J, a=a, F_ext=F, T_drive=T, z=z, v=v, psi=psi, Omega=Om)
         e = f.run(rem, BIG)
         assert 0.0 <= e.duration <= rem
         if e.event == "contact":
@@ -405,7 +410,8 @@ def test_random_flights_invariants() -> None:
         else:
             assert e.duration == rem and abs(e.z) <= p.c_r * (1 + 1e-14)
         if f.closed:
-            ei = SpinFlight(p, J, a, F, T, z, v, psi, Om, force_integration=True).run(rem, BIG)
+            ei = SpinFlight(p, J, a=a, F_ext=F, T_drive=T, z=z, v=v, psi=psi, Omega=Om,
+                            force_integration=True).run(rem, BIG)
             assert ei.event == e.event
             assert abs(ei.duration - e.duration) <= 1e-12 * rem
 

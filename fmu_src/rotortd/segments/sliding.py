@@ -41,15 +41,16 @@ control cost about as much as 8 evaluations (measured; docs/model.md 7)."""
 
 
 class Sliding:
-    """One sliding segment with slip sign ``s`` from (theta0, dtheta0, E0)."""
+    """One sliding segment with slip sign ``slip`` from (theta0, dtheta0, E0)."""
 
     def __init__(
         self,
         wf: WallForces,
+        *,
         theta0: float,
         dtheta0: float,
         E0: complex,
-        s: float,
+        slip: float,
         gn_slack: float = 0.0,
         step0: float = math.inf,
         aux: bool = True,
@@ -58,8 +59,8 @@ class Sliding:
         self.aux = aux  # refine the auxiliary quadrature Z (False: Z is not needed)
         self.step0 = step0  # first integrator step (s); inf: 0.05/w
         self.gn_slack = gn_slack  # lift-off only once Gn < -gn_slack (1/s^2)
-        self.s = s
-        self.mus = wf.mu * s
+        self.slip = slip  # the slip sign, sign(v_rel)
+        self.mus = wf.mu * slip
         self.theta0 = theta0
         self.dtheta0 = dtheta0
         self.E0 = E0
@@ -190,7 +191,7 @@ class Sliding:
         gn += self.gn_slack
         if self.wf.mu == 0.0:  # frictionless: the slip direction carries no physics
             return gn, 1.0
-        return gn, self.s * (self.wf.wr + y[1])
+        return gn, self.slip * (self.wf.wr + y[1])
 
     def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Integrate up to ``rem`` seconds or the first event; the end carries the next

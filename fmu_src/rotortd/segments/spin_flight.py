@@ -163,6 +163,7 @@ class SpinFlight:
         self,
         p: RotorParams,
         J: float,
+        *,
         a: float,
         F_ext: complex,
         T_drive: float,
@@ -170,7 +171,6 @@ class SpinFlight:
         v: complex,
         psi: float,
         Omega: float,
-        *,
         force_integration: bool = False,
         bearing: CounterBody | None = None,
     ) -> None:
