@@ -153,6 +153,7 @@ class Par:
 
 
 def _sgn(x: float) -> float:
+    x = float(x)
     return float((x > 0.0) - (x < 0.0))
 
 
@@ -949,10 +950,12 @@ def energy_terms(par: Par, y0: np.ndarray, y1: np.ndarray) -> dict[str, float]:
 
 
 def momentum_terms(par: Par, y0: np.ndarray, y1: np.ndarray) -> dict[str, float]:
-    """The angular-momentum balance about the origin: ``dL - L_ext - L_couple = 0`` [N m s],
+    """The angular-momentum balance about the origin, its terms signed to sum to 0 [N m s]:
+    ``dL + L_ext + L_couple = 0``, ``L_ext = -int(external torques)``,
     with ``L_ext`` the angular impulse of the drive, the AMB and external forces, gravity at
     the mass centre, the support damper and the race drag (or the static torque holding the
-    race), and ``L_couple = int -delta F_t dt`` the compliant contact's internal couple."""
+    race), and ``L_couple = -int(-delta F_t) dt`` from the compliant contact's internal
+    couple ``-delta F_t``."""
     d = {"dL": momentum(par, y1) - momentum(par, y0),
          "L_ext": -(float(y1[19]) - float(y0[19])),
          "L_couple": -(float(y1[21]) - float(y0[21]))}
@@ -1002,7 +1005,7 @@ def _whirl_force(par: Par, nu: float, rho: float) -> tuple[complex, complex, com
 
 
 def black_whirls(par: Par, Omega: float, chi: float | None = None,
-                 nu_range: tuple[float, float] = (-2e4, 2e4), n_scan: int = 4001
+                 nu_range: tuple[float, float] = (-2e4, 2e4), n_scan: int = 4000
                  ) -> list[Whirl]:
     """The steady rolling and sliding whirls of Black's problem (e_c = g = 0, spin Omega
     held, race not turning or turning at the steady speed where its drag takes R_b F_t;
