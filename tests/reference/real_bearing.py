@@ -63,6 +63,8 @@ DELTA_REF = 1e-5
 """Reference penetration [m] at which ``k_c`` is the contact stiffness."""
 V_FLOOR = 1e-3
 """Default floor [m/s] of the approach speed that sets the contact damping chi."""
+RIGID_V_MIN = 1e-6
+"""Rigid law: an impact slower than this [m/s] stops the run (sustained contact follows)."""
 
 NY = 22
 """Length of the state vector (see :data:`STATE`)."""
@@ -112,6 +114,7 @@ class Par:
     m_b: float = 2.0
     k_b: float = 5e7
     c_b: float = 2e3
+    contact_compliant: bool = True
     k_c: float = 1e9
     p_c: float = 1.0
     v_floor: float = V_FLOOR
@@ -122,8 +125,10 @@ class Par:
     def __post_init__(self) -> None:
         if self.p_c not in (1.0, 1.5):
             raise ValueError(f"p_c = {self.p_c!r} must be 1 or 1.5")
-        if not 0.0 < self.d <= 1.0:
+        if self.contact_compliant and not 0.0 < self.d <= 1.0:
             raise ValueError(f"d = {self.d!r} must lie in (0, 1] under the compliant law")
+        if not 0.0 <= self.d <= 1.0:
+            raise ValueError(f"d = {self.d!r} must lie in [0, 1]")
         for name in ("m", "c_r", "R", "J", "k_c", "v_floor"):
             if not getattr(self, name) > 0.0:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
@@ -613,7 +618,7 @@ def energy(par: Par, y: np.ndarray) -> float:
     T += 0.5 * par.m_b * abs(k.vb) ** 2 + 0.5 * (par.J_b if par.race_turns else 0.0) * k.wb**2
     V = 0.5 * par.a * par.k * abs(k.z) ** 2 + par.m * par.g * zG.imag
     V += 0.5 * par.k_b * abs(k.zb) ** 2
-    if k.delta > 0.0:
+    if k.delta > 0.0 and par.contact_compliant:
         V += par.K * k.delta ** (par.p_c + 1.0) / (par.p_c + 1.0)
     return T + V
 
@@ -645,6 +650,8 @@ class Result:
     t_end: float = 0.0
     nfev: int = 0
     phases: int = 0
+    impacts: list[dict[str, float]] = field(default_factory=list)
+    status: str = "ok"
 
     @property
     def N_peak(self) -> float:
@@ -813,6 +820,24 @@ class Simulator:
                     return brentq(de, a, tm, xtol=1e-16, rtol=4 * np.finfo(float).eps)
         return None
 
+    def _rigid_impact(self, res: Result, t: float, y: np.ndarray) -> bool:
+        """Apply a rigid impact in place (impulses and dissipation into the integrals); False
+        (status set) when the impacts have become too slow to resolve: sustained rigid
+        contact is not implemented in this reference."""
+        p = self.p
+        k = kin(p, y)
+        if k.ddelta < RIGID_V_MIN:
+            res.status = "rigid sustained contact (not implemented)"
+            return False
+        y1, out = pair_impact(p, y)
+        y1[14] += -out["dT"]  # impacts dissipate into the contact's column
+        y1[20] += out["P_n"]
+        if not p.race_turns:  # the frame holds the race's spin: external angular impulse
+            y1[19] += -p.R_b * out["P_t"]
+        y[:] = y1
+        res.impacts.append({"t": t, "v_in": k.ddelta, "v_rel_in": k.vrel, **out})
+        return True
+
     # ---- run ---------------------------------------------------------------------------------
 
     def run(self, y0: np.ndarray, t0: float, t_end: float, grid: np.ndarray | None = None,
@@ -826,7 +851,7 @@ class Simulator:
         gy = np.full((len(grid), NY), np.nan)
         gmode: list[str] = [""] * len(grid)
         k = kin(p, y)
-        mode = Mode(contact=k.delta > 0.0)
+        mode = Mode(contact=p.contact_compliant and k.delta > 0.0)
         if mode.contact:
             vin = k.ddelta if v_in0 is None else v_in0
             mode.chi = c_d(p.d) / max(vin, p.v_floor)
@@ -879,6 +904,12 @@ class Simulator:
             new = replace(mode)
             force = ""
             k = kin(p, y)
+            if fired == "close" and not p.contact_compliant:
+                if not self._rigid_impact(res, t, y):
+                    break
+                mode = self.decide(y, Mode(contact=False, held=mode.held, sigma=mode.sigma))
+                res.transitions.append((t, "impact/" + mode.name()))
+                continue
             if fired == "close":
                 new = Mode(contact=True, held=mode.held, sigma=mode.sigma,
                            chi=c_d(p.d) / max(k.ddelta, p.v_floor))
