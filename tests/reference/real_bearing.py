@@ -229,7 +229,8 @@ class SingleImpact:
     v_out: float
 
 
-def single_impact(m_eff: float, v_in: float, k_c: float, p: float, d: float) -> SingleImpact:
+def single_impact(m_eff: float, v_in: float, k_c: float, p: float, d: float, dps: int = 20
+                  ) -> SingleImpact:
     """Exact single-impact figures of ``m_eff delta'' = -K delta^p (1 + chi delta')``,
     ``chi = c_d(d)/v_in``, from the law's energy integral (no time stepping):
 
@@ -241,8 +242,8 @@ def single_impact(m_eff: float, v_in: float, k_c: float, p: float, d: float) -> 
     forms (p = 1: ``T = pi sqrt(m/k_c)``; p = 3/2: ``T = 2.9432752 delta_max/v_in``).
     """
     K = k_c * DELTA_REF ** (1.0 - p)
-    with mpmath.workdps(30):
-        c = c_d_mp(d)
+    with mpmath.workdps(dps):
+        c = +c_d_mp(d)
         mm, vi, KK, pp = (mpmath.mpf(x) for x in (m_eff, v_in, K, p))
         if c == 0:
             def G(v: Any) -> Any:
@@ -638,7 +639,9 @@ def momentum(par: Par, y: np.ndarray) -> float:
 
 @dataclass
 class Result:
-    """A trajectory: grid samples, contact intervals, peaks, transitions, final state."""
+    """A trajectory: grid samples (``t``, ``y``, ``modes``), contact intervals (``contacts``:
+    t_close, t_open, v_in, v_out, N_peak), located peaks of N (``peaks``) and N at phase ends
+    in contact (``boundary_N``), mode transitions, rigid impacts, the final state."""
 
     t: np.ndarray
     y: np.ndarray
@@ -652,11 +655,13 @@ class Result:
     phases: int = 0
     impacts: list[dict[str, float]] = field(default_factory=list)
     status: str = "ok"
+    boundary_N: list[tuple[float, float]] = field(default_factory=list)
 
     @property
     def N_peak(self) -> float:
-        """Largest located peak of the normal force [N] (0 without contact)."""
-        return max((n for _, n in self.peaks), default=0.0)
+        """Largest normal force [N]: located peaks (zeros of dN/dt) and the values at phase
+        ends in contact (0 without contact)."""
+        return max((n for _, n in self.peaks + self.boundary_N), default=0.0)
 
     def first(self, label: str) -> float | None:
         """Time of the first transition whose mode name starts with ``label``."""
@@ -895,6 +900,12 @@ class Simulator:
                 gy[sel] = sol.sol(grid[sel]).T
                 for i in np.nonzero(sel)[0]:
                     gmode[i] = mode.name()
+            if mode.contact and not mode.clamped:
+                # N's largest value can sit at a phase end (dN/dt jumps where F_t does)
+                Nb = md.normal(kin(p, y_stop), mode)[0]
+                res.boundary_N.append((t_stop, Nb))
+                if cur_contact is not None:
+                    cur_contact["N_peak"] = max(cur_contact["N_peak"], Nb)
             zero_len = zero_len + 1 if t_stop - t <= 1e-15 * max(1.0, abs(t)) else 0
             if zero_len > 20:
                 raise RuntimeError(f"no progress at t = {t}: mode {mode.name()}, event {fired}")
