@@ -1124,7 +1124,7 @@ def _stability(par: Par, Omega: float, nu: float, A: complex, B: complex, chi: f
     differences, relative step 1e-6; accurate to ~1e-6 of the largest rate). Trivial zero
     eigenvalues (the rotation of the whole whirl; in rolling, the conserved slip) are removed:
     the ``n0`` eigenvalues of smallest modulus, below 1e-4 of the largest."""
-    p = par.with_(T_drive=0.0)
+    p = par.with_(T_drive=0.0, J=1e300)  # the spin held
     md = Model(p)
     mode = Mode(contact=True, stick=stick, s=s, held=True, chi=chi)
     comp = par.support_compliant
