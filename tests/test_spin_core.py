@@ -245,3 +245,22 @@ def test_wall_forces_follow_the_spin_state() -> None:
     wf = core.wall_forces
     assert core.Omega != 184.2
     assert wf.Omega == core.Omega and wf.kappa == wf.beta == 0.0  # kappa = a k/m, beta = a c/m
+
+
+def test_published_amb_force_is_the_one_definition() -> None:
+    """The outputs' F_amb (TouchdownCore.output_values inlines it for speed) equals
+    RotorParams.amb_force at random states of both rotors, bit for bit."""
+    import random
+
+    from rotortd import TouchdownCore
+
+    rng = random.Random(5)
+    for _ in range(200):
+        p = CHAPTER_G.replace(c=rng.uniform(0.0, 3000.0), k=rng.uniform(0.0, 2e6))
+        z = p.c_r * 0.9 * cmath.rect(rng.random(), rng.uniform(-3.0, 3.0))
+        v = complex(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2))
+        a = rng.choice((0.0, 1.0, rng.random()))
+        for core in (TouchdownCore(p, z0=z, v0=v), SpinCore(p, J_HALF, z0=z, v0=v)):
+            out = core.outputs(184.2, a)
+            F = p.amb_force(a, z, v)
+            assert (out.F_amb_x, out.F_amb_y) == (F.real, F.imag)

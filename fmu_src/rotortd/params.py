@@ -123,7 +123,8 @@ class RotorParams:
         """The AMB force on the rotor centre at (z (m), v (m/s)), N, inertial: the one
         definition a (F_bias - c v - k z), a = amb_on in [0, 1]. The integrators' kernels
         expand it in their own variables (segments.spin_flight, segments.spin_contact,
-        segments.flight, contact.wall)."""
+        segments.flight, contact.wall), and the outputs inline it (TouchdownCore.output_values,
+        every FMU step; tests/test_spin_core.py checks it there)."""
         return a * (self.bias_force - self.c * v - self.k * z)
 
     @property

@@ -46,7 +46,6 @@ class Sliding:
     def __init__(
         self,
         wf: WallForces,
-        *,
         theta0: float,
         dtheta0: float,
         E0: complex,

@@ -163,7 +163,6 @@ class SpinFlight:
         self,
         p: RotorParams,
         J: float,
-        *,
         a: float,
         F_ext: complex,
         T_drive: float,
@@ -171,6 +170,7 @@ class SpinFlight:
         v: complex,
         psi: float,
         Omega: float,
+        *,
         force_integration: bool = False,
         bearing: CounterBody | None = None,
     ) -> None:

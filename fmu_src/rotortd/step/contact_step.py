@@ -99,8 +99,8 @@ class ContactSteps:
             end = rub.run(rem)
         else:
             slack = 2.0 * wf.gn_tol(self._dtheta) if sticky else 0.0
-            seg = Sliding(wf, theta0=self._theta, dtheta0=self._dtheta, E0=E, slip=self._slip,
-                          gn_slack=slack, step0=self._slide_step, aux=self.imbalance_torque)
+            seg = Sliding(wf, self._theta, self._dtheta, E, self._slip, slack, self._slide_step,
+                          self.imbalance_torque)  # (positional: built every segment)
             end = seg.run(self._slide_span(rem), st.cap - st.work.total)
             self._slide_step = end.next_step
         st.work.iters += end.work

@@ -127,8 +127,8 @@ class FlightSteps:
         if not self._clear and not self._on_wall and t0 + s >= self._envelope_at:
             st.work.evals += 1  # (on the wall the bound is >= |z| = c_r: it cannot prove)
             self._check_envelope(self._fm, t0 + s, E)
-        seg = Flight(self._fm, z0=self._z, v0=self._v, E=E, on_wall=self._on_wall,
-                     search=not self._clear, resumed=s > 0.0)
+        # (positional: a segment is built every flight, and 7 keywords cost 0.85 us)
+        seg = Flight(self._fm, self._z, self._v, E, self._on_wall, not self._clear, s > 0.0)
         end = seg.run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         return self._end_flight(end, seg, s, h, rem, t0, rep, st)
@@ -241,8 +241,8 @@ class Flight:
 
     __slots__ = ("E", "fm", "on_wall", "resumed", "search", "v0", "z0")
 
-    def __init__(self, fm: FlightModel, *, z0: complex, v0: complex, E: complex,
-                 on_wall: bool, search: bool, resumed: bool) -> None:
+    def __init__(self, fm: FlightModel, z0: complex, v0: complex, E: complex, on_wall: bool,
+                 search: bool, resumed: bool) -> None:
         self.fm, self.z0, self.v0, self.E = fm, z0, v0, E
         self.on_wall, self.search, self.resumed = on_wall, search, resumed
 

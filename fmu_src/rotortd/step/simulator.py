@@ -338,7 +338,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         rr = r * r
         whirl = (z.real * v.imag - z.imag * v.real) / rr if rr > 0.0 else (
             ((z.real * v.imag - z.imag * v.real) / r) / r if r > 0.0 else 0.0)
-        F_amb = p.amb_force(a, z, v)
+        F_amb = a * (self._bias_force - p.c * v - p.k * z)  # (RotorParams.amb_force inline)
         return (
             z.real, z.imag, v.real, v.imag, r / c_r, U.real / c_r, U.imag / c_r,
             dU.real, dU.imag, -psi if psi == -math.pi else psi, whirl,
@@ -454,6 +454,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         """New held inputs (or parameters): rebuild the flight and wall models."""
         self._inputs: tuple[float, complex, float] = (W, F, a)
         self._fm = FlightModel(self._p, W, F, a)
+        self._bias_force = self._p.bias_force  # (N; output_values, every FMU step)
         self._imb_free_h = math.nan  # FlightSteps._imb_flight: for this flight model
         self._imb_seen_h = math.nan
         self._imb_free: tuple[complex, complex, complex, float] = (0j, 0j, 0j, 0.0)

@@ -97,9 +97,8 @@ class SpinSteps:
         contact at its end."""
         rem = (h - s) - st.s_lo
         held = st.held
-        end = SpinFlight(self._p, self._J, a=held.a, F_ext=held.F_ext, T_drive=held.T_drive,
-                         z=self._z, v=self._v, psi=self._psi, Omega=self._inputs[0],
-                         ).run(rem, st.cap - st.work.total)
+        end = SpinFlight(self._p, self._J, held.a, held.F_ext, held.T_drive, self._z, self._v,
+                         self._psi, self._inputs[0]).run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         self._z, self._v = end.z, end.v
         self._spin_advance_spin(end)
