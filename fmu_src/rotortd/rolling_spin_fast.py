@@ -1,0 +1,488 @@
+"""Dry whirl with the spin as a state, by its energy integral: rolling on the fixed rigid race
+at a cost that does not grow with the speed (docs/notes/dry-whirl-quadrature.md).
+
+Frame and units: inertial, SI, as ``spin_contact``. The contact point is z = c_r n,
+n = e^{i theta}; E = e^{i(psi + phi)}, beta = psi + phi - theta, rho = R/c_r. Rolling
+(v_rel = 0) on the fixed race has c_r theta' = -R Omega, so with sigma = sign(Omega) and
+u >= 0 the unsigned spin angle travelled (rad),
+
+    psi = psi0 + sigma u,   theta = theta0 - rho sigma u,   beta = beta0 + (1 + rho) sigma u.
+
+With the bearing's damper off (a c = 0) and gravity, F_ext and T_drive held, the contact
+force does no work and the spring force -a k z none on the circle, so
+
+    1/2 I_P(beta) Omega^2 + V(theta, psi) = const,   I_P = J + m (R^2 + e_c^2 - 2 R e_c cos beta),
+    V = -c_r Re(conj(G) n) + m g e_c sin(psi + phi) - T_drive psi,   G = a F_bias + F_ext - i m g,
+
+and the time is the quadrature dt = du / |Omega| = F(theta(u), psi(u)) du with
+F(theta, psi) = sqrt(I_P / (K0 - 2 (V - V0))), K0 = I_P(beta0) Omega0^2, a smooth function on
+the torus (theta, psi) for psi in the panel.
+
+Two ways to evaluate t(u) = int_0^u F du on a panel u in [0, L] (L <= L_MAX rad of psi):
+
+- direct (the contact angle turns by at most BETA_DIRECT rad over the panel): Chebyshev
+  interpolation of F along the path at P_DIRECT nodes, integrated exactly;
+- Fourier-Levin (any speed): F(theta, psi) = sum_k Q_k(psi) e^{i k theta}, the Q_k from an
+  N_GRID-point DFT in theta at P_CHEB Chebyshev nodes in u; on the path e^{i k theta(u)} =
+  e^{i k theta0} e^{-i k rho sigma u}, and int Q_k(u) e^{-i k rho sigma u} du = [y_k(u)
+  e^{-i k rho sigma u}] with y_k the polynomial solution of y' - i k rho sigma y = Q_k
+  (backward recurrence on its monomial coefficients, stable when |k| rho L/2 > P_CHEB). So
+  t(u) = mean part (k = 0, a polynomial) + the periodic remainder at the two ends: a fixed
+  amount of work, whatever the number of turns of beta in the panel.
+
+The step end is the root of t(u) = rem (Newton with t'(u) = F on the path); the end state
+follows from the energy integral. The impulses int N, int F_t and int F_c of the segment are
+the same quadratures of (N + i F_t) F (and times e^{i theta}).
+
+Events: none is allowed in a panel. A panel is taken only when bounds over every (theta,
+psi) of the panel and every Omega^2 the energy allows there prove N > 0 and |F_t| < mu N
+(``_no_event``); otherwise ``advance`` returns None and the extrapolation integrator of
+``spin_contact`` (which locates the event) takes the segment. At speed N is dominated by
+the centripetal term m c_r rho^2 Omega^2, so the bound holds at any speed when
+mu > ~ (e_c/(c_r rho^2) + m R e_c/I_P) (docs/notes/dry-whirl-quadrature.md §4).
+
+Errors (estimated, not enclosed): the truncated harmonics and the Chebyshev tails are
+required below TOL_PHASE rad of theta (converted to time by 1/(rho |Omega|)); otherwise
+``advance`` declines (None).
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from operator import mul
+from typing import TYPE_CHECKING
+
+from .wall import ContactTally, SegmentEnd
+
+if TYPE_CHECKING:
+    from .spin_contact import HeldInputs
+
+P_CHEB = 10
+"""Chebyshev nodes in u of the Fourier-Levin panel."""
+N_GRID = 16
+"""Points of the DFT in theta."""
+K_MAX = 6
+"""Harmonics in theta kept (|k| <= K_MAX); K_MAX + 1, K_MAX + 2 are computed as the check."""
+P_DIRECT = 20
+"""Chebyshev nodes along the path in the direct mode."""
+BETA_DIRECT = 4.0
+"""Largest turn of the contact angle theta (rad) over a panel of the direct mode."""
+L_MAX = 1.0
+"""Largest panel, rad of psi."""
+TOL_PHASE = 1e-14
+"""Largest estimated truncation error of a panel in theta, relative to 1 + the turn of theta
+over the panel (rad); rounding alone is a few eps of that turn."""
+TOL_IMPULSE = 1e-14
+"""Largest estimated truncation error of the impulses, relative to their mean rate times the
+panel."""
+MARGIN = 1e-9
+"""Relative margin of the event bounds (their rounding is a few eps)."""
+NEWTON_ITERS = 12
+"""Most Newton iterations of the step end (it converges in 3 to 5)."""
+SAMPLE_WORK = 2
+"""Work units per sample of the integrand (as spin_contact.RHS_WORK per right-hand side)."""
+
+
+def _cheb_tables(p: int) -> tuple[list[float], list[list[float]], list[list[float]]]:
+    """Chebyshev points of the first kind x_i, the map from values to Chebyshev coefficients
+    (row m: a_m = sum_i CH[m][i] v_i) and the monomial coefficients of T_m (row j: x^j)."""
+    xs = [math.cos(math.pi * (i + 0.5) / p) for i in range(p)]
+    ch = [[(1.0 if m else 0.5) * 2.0 / p * math.cos(m * math.pi * (i + 0.5) / p)
+           for i in range(p)] for m in range(p)]
+    t = [[0.0] * p for _ in range(p)]  # t[m][j]: coefficient of x^j in T_m
+    t[0][0] = 1.0
+    if p > 1:
+        t[1][1] = 1.0
+    for m in range(2, p):
+        for j in range(p):
+            t[m][j] = (2.0 * t[m - 1][j - 1] if j else 0.0) - t[m - 2][j]
+    tm = [[t[m][j] for m in range(p)] for j in range(p)]  # row j over m
+    return xs, ch, tm
+
+
+_XL, _CHL, _TML = _cheb_tables(P_CHEB)
+_MXL = [[sum(map(mul, row_j, col)) for col in zip(*_CHL)] for row_j in _TML]
+"""Values at _XL -> monomial coefficients in one product (row j: x^j)."""
+_XD, _CHD, _ = _cheb_tables(P_DIRECT)
+_TH = [2.0 * math.pi * j / N_GRID for j in range(N_GRID)]
+_CT = [math.cos(a) for a in _TH]
+_ST = [math.sin(a) for a in _TH]
+_EM = [[cmath.exp(-1j * k * a) / N_GRID for a in _TH] for k in range(-K_MAX - 1, K_MAX + 3)]
+"""_EM[k + K_MAX + 1][l] = e^{-i k theta_l}/N: the DFT rows, k = -K_MAX-1 .. K_MAX+2."""
+
+
+def _row(k: int) -> list[complex]:
+    return _EM[k + K_MAX + 1]
+
+
+def applies(h: HeldInputs) -> bool:
+    """The method's physics holds: the bearing's damper does no work (a c = 0)."""
+    return h.a * h.p.c == 0.0
+
+
+class DryWhirl:
+    """Rolling from (theta, psi, Omega) under the held inputs ``h`` (a c = 0), advanced by the
+    energy integral (module docstring). ``advance`` returns the segment's end, or None when
+    the method does not apply to this panel (then the integrator must take it)."""
+
+    def __init__(self, h: HeldInputs, theta: float, psi: float, Omega: float) -> None:
+        p = h.p
+        self.h = h
+        self.m, self.c_r, self.R, self.e_c, self.phi, self.mu = (p.m, p.c_r, p.R, p.e_c,
+                                                                 p.phi, p.mu)
+        self.J, self.T = h.J, h.T_drive
+        F1 = h.a * p.bias_force + h.F_ext  # constant force at the geometric centre (N)
+        self.F1x, self.F1y = F1.real, F1.imag
+        self.Gx, self.Gy = F1.real, F1.imag - p.m * p.g  # with gravity (G, N)
+        self.mge = p.m * p.g * p.e_c
+        self.akcr = h.a * p.k * p.c_r
+        self.rho = p.R / p.c_r
+        self.sig = 1.0 if Omega >= 0.0 else -1.0
+        self.theta0, self.psi0, self.Omega0 = theta, psi, Omega
+        self.I0 = self.J + p.m * (p.R * p.R + p.e_c * p.e_c)
+        self.c2 = 2.0 * p.m * p.R * p.e_c  # I_P = I0 - c2 cos(beta)
+        cb0 = math.cos(psi + p.phi - theta)
+        self.K0 = (self.I0 - self.c2 * cb0) * Omega * Omega  # I_P(beta0) Omega0^2 (J)
+        self.ct0, self.st0 = math.cos(theta), math.sin(theta)
+        self.sE0 = math.sin(psi + p.phi)
+        self.v0 = self.c_r * (self.Gx * self.ct0 + self.Gy * self.st0)  # -(theta part of V0)
+
+    # ------------------------------------------------------------------ the physics
+
+    def _dv_psi(self, u: float) -> tuple[float, float, float]:
+        """(the psi part of V - V0 plus the theta part of -V0 (J), cos, sin of psi + phi)."""
+        a = self.psi0 + self.sig * u + self.phi
+        cE, sE = math.cos(a), math.sin(a)
+        return self.v0 + self.mge * (sE - self.sE0) - self.T * self.sig * u, cE, sE
+
+    def _forces(self, ct: float, st: float, cE: float, sE: float, dv: float
+                ) -> tuple[float, float, float, float]:
+        """(F = 1/|Omega| (s/rad), N (N), F_t (N), Omega^2) at n = ct + i st,
+        E = cE + i sE with V - V0 = dv (J), Omega^2 from the energy integral. The forces as
+        ``spin_contact.ContactModel.rolling`` with a c = 0."""
+        m, e_c = self.m, self.e_c
+        cb, sb = cE * ct + sE * st, sE * ct - cE * st
+        IP = self.I0 - self.c2 * cb
+        om2 = (self.K0 - 2.0 * (dv - self.c_r * (self.Gx * ct + self.Gy * st))) / IP
+        U = m * e_c * om2
+        rn = (self.Gx * ct + self.Gy * st - self.akcr + U * cb
+              + m * self.c_r * self.rho * self.rho * om2)
+        Fot = self.Gy * ct - self.Gx * st + U * sb
+        T = self.T + e_c * (self.F1x * sE - self.F1y * cE) - self.akcr * e_c * sb
+        B, A = e_c * sb, self.R - e_c * cb
+        dW = (T - B * rn - A * Fot) / IP
+        return 1.0 / math.sqrt(om2), rn + m * B * dW, Fot + m * A * dW, om2
+
+    def _path(self, u: float) -> tuple[float, float, float, float, float]:
+        """(F, N, F_t, Omega^2, theta) on the path at u."""
+        th = self.theta0 - self.rho * self.sig * u
+        dv, cE, sE = self._dv_psi(u)
+        return (*self._forces(math.cos(th), math.sin(th), cE, sE, dv), th)
+
+    # ------------------------------------------------------------------ bounds
+
+    def _omega2_bounds(self, L: float) -> tuple[float, float]:
+        """Bounds of Omega^2 over every (theta, psi) of the panel [0, L] (rad^2/s^2)."""
+        Gm = math.hypot(self.Gx, self.Gy)
+        Vb = (self.c_r * Gm * min(2.0, self.rho * L) + self.mge * min(2.0, L)
+              + abs(self.T) * L)
+        m, R, e_c = self.m, self.R, self.e_c
+        Ilo, Ihi = self.J + m * (R - e_c) ** 2, self.J + m * (R + e_c) ** 2
+        return (self.K0 - 2.0 * Vb) / Ihi, (self.K0 + 2.0 * Vb) / Ilo
+
+    def _no_event(self, lo: float, hi: float) -> bool:
+        """N > 0 and |F_t| < mu N at every (theta, psi) of the panel and every Omega^2 in
+        [lo, hi] (docs/notes/dry-whirl-quadrature.md §4)."""
+        m, R, e_c, c_r = self.m, self.R, self.e_c, self.c_r
+        Gm = math.hypot(self.Gx, self.Gy)
+        U = m * e_c * hi
+        cen = m * c_r * self.rho * self.rho
+        rn_lo = cen * lo - Gm - self.akcr - U
+        rn_hi = cen * hi + Gm + U
+        Fo = Gm + U
+        T = abs(self.T) + e_c * math.hypot(self.F1x, self.F1y) + self.akcr * e_c
+        Ilo = self.J + m * (R - e_c) ** 2
+        dW = (T + e_c * rn_hi + (R + e_c) * Fo) / Ilo
+        N_lo = (rn_lo - m * e_c * dW) * (1.0 - MARGIN)
+        Ft_hi = (Fo + m * (R + e_c) * dW) * (1.0 + MARGIN)
+        return N_lo > 0.0 and Ft_hi < self.mu * N_lo
+
+    # ------------------------------------------------------------------ the step
+
+    def advance(self, rem: float, limit: int, step0: float = math.inf,
+                levin: bool | None = None) -> SegmentEnd | None:
+        """Advance at most rem (s): the end of the panel or of rem, whichever comes first
+        (no event can occur in a panel taken). None when the method does not apply (energy
+        too close to a turning point, an event not excluded, the truncation estimate above
+        TOL_PHASE, or a work limit below the panel's cost). ``levin`` forces the mode (None:
+        direct when the panel's theta turn is at most BETA_DIRECT, else Fourier-Levin)."""
+        if not (rem > 0.0 and self.K0 > 0.0 and math.isfinite(self.K0)):
+            return None
+        lo, hi = self._omega2_bounds(L_MAX)
+        if not lo > 0.5 * self.Omega0 * self.Omega0:
+            return None
+        L = min(L_MAX, rem * math.sqrt(hi) * (1.0 + 1e-9))
+        direct = self.rho * L <= BETA_DIRECT if levin is None else not levin
+        if not direct:
+            L = max(L, 2.0 * (P_CHEB + 1) / self.rho)
+            if L > L_MAX:
+                return None
+        work = SAMPLE_WORK * (P_DIRECT + 2 * NEWTON_ITERS if direct
+                           else P_CHEB * N_GRID + 2 * NEWTON_ITERS)
+        if work > limit:
+            return None
+        lo, hi = self._omega2_bounds(L)
+        if not self._no_event(lo, hi):
+            return None
+        tol_t = TOL_PHASE * (1.0 + self.rho * L) / (self.rho * math.sqrt(lo))
+        panel = _DirectPanel(self, L) if direct else _LevinPanel(self, L)
+        if not panel.error_estimate() <= tol_t:
+            return None
+        if panel.t(L) <= rem:
+            u, dur = L, panel.t(L)
+        else:
+            u, dur = self._newton(panel, rem, L), rem
+        return self._end(panel, u, dur, work, step0)
+
+    def _newton(self, panel: _DirectPanel | _LevinPanel, rem: float, L: float) -> float:
+        """The root u in [0, L] of t(u) = rem (t increasing, t' = F on the path)."""
+        u = min(L, rem * abs(self.Omega0))
+        for _ in range(NEWTON_ITERS):
+            du = (panel.t(u) - rem) / self._path(u)[0]
+            u = min(L, max(0.0, u - du))
+            if abs(du) <= 2.0 * math.ulp(u):
+                break
+        return u
+
+    def contact_impulse(self, u: float, dur: float, int_n: complex) -> complex:
+        """int F_c dt (N s) over [0, u] lasting dur (s), from the momentum balance
+        m dz_G' = (F1 - i m g - a k z + F_c) dt (a c = 0), z_G' = i Omega (e_c E - R n);
+        int_n = int n dt (s), needed only when a k != 0."""
+        def zg_dot(uu: float) -> complex:
+            _, _, _, om2, th = self._path(uu)
+            E = cmath.exp(1j * (self.psi0 + self.sig * uu + self.phi))
+            return 1j * self.sig * math.sqrt(om2) * (self.e_c * E - self.R * cmath.exp(1j * th))
+        G = complex(self.Gx, self.Gy)
+        return self.m * (zg_dot(u) - zg_dot(0.0)) - G * dur + self.akcr * int_n
+
+    def _end(self, panel: _DirectPanel | _LevinPanel, u: float, dur: float, work: int,
+             step0: float) -> SegmentEnd:
+        _, N, _, om2, th = self._path(u)
+        Om = self.sig * math.sqrt(om2)
+        P, Pc = panel.impulses(u, dur)
+        mc = self.m * self.c_r  # the tally is per unit m c_r (wall.ContactTally)
+        peak = max([abs(N)] + [n for uu, n in zip(panel.us, panel.Ns) if uu <= u])
+        tally = ContactTally(I_n=P.real / mc, I_c=Pc / mc, I_t=P.imag / mc, I_e=0.0,
+                             peak=peak / mc, work=work)
+        return SegmentEnd(dur, th, -self.rho * Om, None, tally, step0,
+                          psi=self.psi0 + self.sig * u, Omega=Om, work=work)
+
+
+def _clenshaw_int(a: list[complex], x: float) -> complex:
+    """int_{-1}^{x} sum_m a_m T_m(xi) d xi (a_0 not halved)."""
+    p = len(a)
+    b = [0j] * (p + 1)
+    b[1] = a[0] - (a[2] if p > 2 else 0.0) / 2.0
+    for m in range(2, p + 1):
+        b[m] = ((a[m - 1] if m - 1 < p else 0.0) - (a[m + 1] if m + 1 < p else 0.0)) / (2 * m)
+    b[0] = -sum(bm * (-1) ** m for m, bm in enumerate(b) if m)
+    # Clenshaw
+    bk1 = bk2 = 0j
+    for m in range(p, 0, -1):
+        bk1, bk2 = 2.0 * x * bk1 - bk2 + b[m], bk1
+    return x * bk1 - bk2 + b[0]
+
+
+class _DirectPanel:
+    """F, (N + i F_t) F and (N + i F_t) F n along the path at Chebyshev nodes of [0, L]."""
+
+    def __init__(self, w: DryWhirl, L: float) -> None:
+        self.L = L
+        self.w = w
+        fs, ds, ns = [], [], []
+        self.us = [0.5 * L * (1.0 + x) for x in _XD]
+        self.Ns = []
+        for u in self.us:
+            F, N, Ft, _, th = w._path(u)
+            fs.append(F)
+            ds.append(complex(N * F, Ft * F))
+            ns.append(F * cmath.exp(1j * th))
+            self.Ns.append(abs(N))
+        self.af = [sum(map(mul, fs, row)) for row in _CHD]
+        self.ad = [sum(map(mul, ds, row)) for row in _CHD]
+        self.an = [sum(map(mul, ns, row)) for row in _CHD] if w.akcr else []
+        self.scale_d = max(abs(d) for d in ds)
+
+    def error_estimate(self) -> float:
+        """Estimated error (s) of t over the panel: its Chebyshev tail; and of the impulses,
+        relative (inf when above TOL_IMPULSE)."""
+        af = self.af
+        ef = 0.5 * self.L * 2.0 * (abs(af[-1]) + abs(af[-2]))
+        ed = abs(self.ad[-1]) + abs(self.ad[-2])
+        if self.an:
+            ed += self.w.akcr * max(abs(self.an[-1]) + abs(self.an[-2]), 0.0)
+        return ef if ed <= TOL_IMPULSE * self.scale_d else math.inf
+
+    def t(self, u: float) -> float:
+        return 0.5 * self.L * _clenshaw_int(self.af, 2.0 * u / self.L - 1.0).real
+
+    def impulses(self, u: float, dur: float) -> tuple[complex, complex]:
+        """(int (N + i F_t) dt (N s), int F_c dt (N s)) from 0 to u (dur s); the second
+        from the momentum balance (``DryWhirl.contact_impulse``)."""
+        x = 2.0 * u / self.L - 1.0
+        int_n = 0.5 * self.L * _clenshaw_int(self.an, x) if self.an else 0j
+        return (0.5 * self.L * _clenshaw_int(self.ad, x),
+                self.w.contact_impulse(u, dur, int_n))
+
+
+def _mono(vals: list[complex]) -> tuple[list[complex], float]:
+    """Monomial coefficients in x in [-1, 1] of the interpolant of vals at _XL through its
+    Chebyshev coefficients (rounding a few eps of max |vals|), and the size of its Chebyshev
+    tail |a_{p-1}| + |a_{p-2}|."""
+    a = [sum(map(mul, vals, row)) for row in _CHL]
+    return [sum(map(mul, a, row)) for row in _TML], abs(a[-1]) + abs(a[-2])
+
+
+def _mono_fast(vals: list[complex]) -> list[complex]:
+    """The same in one product (_MXL; its rounding is up to ~700 eps of max |vals| at
+    P_CHEB = 10: used for the harmonics k != 0, whose integrals are small)."""
+    return [sum(map(mul, vals, row)) for row in _MXL]
+
+
+def _levin(c: list[complex], w: float) -> list[complex]:
+    """Monomial coefficients of the polynomial y with y' + i w y = c (|w| > len(c): the
+    backward recurrence then does not amplify)."""
+    p = len(c)
+    y = [0j] * p
+    iw = 1j * w
+    nxt = 0j
+    for j in range(p - 1, -1, -1):
+        nxt = (c[j] - (j + 1) * nxt) / iw
+        y[j] = nxt
+    return y
+
+
+def _horner(c: list[complex], x: float) -> complex:
+    r = 0j
+    for cj in reversed(c):
+        r = r * x + cj
+    return r
+
+
+class _LevinPanel:
+    """The Fourier-Levin form of the panel [0, L] (module docstring): the harmonics Q_k of F
+    and D_k of D = (N + i F_t) F in theta, at P_CHEB Chebyshev nodes in u."""
+
+    def __init__(self, w: DryWhirl, L: float) -> None:
+        self.L, self.w = L, w
+        m, e_c, rho, c_r = w.m, w.e_c, w.rho, w.c_r
+        cen, K0, I0, c2, akcr = m * c_r * rho * rho, w.K0, w.I0, w.c2, w.akcr
+        R, Gx, Gy, T0 = w.R, w.Gx, w.Gy, w.T
+        gr = [Gx * c + Gy * s for c, s in zip(_CT, _ST)]  # Re(conj(n) G) on the grid
+        gi = [Gy * c - Gx * s for c, s in zip(_CT, _ST)]  # Im(conj(n) G)
+        vt = [2.0 * c_r * g for g in gr]  # -2 (theta part of V) on the grid
+        rows_f = [_row(k) for k in range(K_MAX + 3)]
+        rows_d = [_row(k) for k in range(-K_MAX - 1, K_MAX + 2)]
+        qf: list[list[complex]] = [[] for _ in rows_f]
+        qd: list[list[complex]] = [[] for _ in rows_d]
+        us = [0.5 * L * (1.0 + x) for x in _XL]
+        for u in us:
+            dv, cE, sE = w._dv_psi(u)
+            base = K0 - 2.0 * dv
+            T = T0 + e_c * (w.F1x * sE - w.F1y * cE)
+            fs, ds = [], []
+            for ct, st, g_r, g_i, v in zip(_CT, _ST, gr, gi, vt):
+                cb, sb = cE * ct + sE * st, sE * ct - cE * st
+                IP = I0 - c2 * cb
+                om2 = (base + v) / IP
+                F = 1.0 / math.sqrt(om2)
+                U = m * e_c * om2
+                rn = g_r - akcr + U * cb + cen * om2
+                Fot = g_i + U * sb
+                B, A = e_c * sb, R - e_c * cb
+                dW = (T - akcr * B - B * rn - A * Fot) / IP
+                fs.append(F)
+                ds.append(complex((rn + m * B * dW) * F, (Fot + m * A * dW) * F))
+            for q, row in zip(qf, rows_f):
+                q.append(sum(map(mul, fs, row)))
+            for q, row in zip(qd, rows_d):
+                q.append(sum(map(mul, ds, row)))
+        self.us = us
+        self.Ns = [abs(w._path(u)[1]) for u in us]  # N on the path at the nodes
+        rs = rho * w.sig * 0.5 * L  # w_k = -k rs: the frequency of harmonic k in x
+        self.rs = rs
+        f0, t0 = _mono(qf[0])
+        f1 = _mono(qf[1])[1]
+        self.f0_int = [cj.real / (j + 1) for j, cj in enumerate(f0)]
+        self.f0_m1 = _horner(self.f0_int, -1.0).real
+        self.yf = []
+        for k in range(1, K_MAX + 1):
+            y = _levin(_mono_fast(qf[k]), -k * rs)
+            self.yf.append((y, _horner(y, -1.0)))
+        self.qf = qf
+        hi = sum(2.0 * max(abs(q) for q in qf[k]) * 2.0 / (k * rho)
+                 for k in (K_MAX + 1, K_MAX + 2))
+        self.est = 0.5 * L * 2.0 * (t0 + f1) + hi
+        d = {k: q for k, q in zip(range(-K_MAX - 1, K_MAX + 2), qd)}
+        self.d0 = _mono(d[0])[0]
+        self.dk = {k: _mono_fast(d[k]) for k in range(-K_MAX, K_MAX + 1) if k}
+        scale_d = max(abs(q) for q in d[0]) * L
+        hi_d = sum(max(abs(q) for q in d[k]) * 2.0 / ((K_MAX + 1) * rho)
+                   for k in (-K_MAX - 1, K_MAX + 1))
+        self.d_ok = hi_d <= TOL_IMPULSE * scale_d
+
+    def error_estimate(self) -> float:
+        """Estimated error of t over the panel (s): the Chebyshev tails of Q_0 and Q_1 over
+        the panel and the dropped harmonics K_MAX + 1, K_MAX + 2 (their oscillatory
+        integrals, 2 |Q_k|/(k rho) each, both signs); inf when the impulses' first dropped
+        harmonics (K_MAX + 1, both signs) integrate to above TOL_IMPULSE of their mean over
+        the panel."""
+        return self.est if self.d_ok else math.inf
+
+    def t(self, u: float) -> float:
+        x = 2.0 * u / self.L - 1.0
+        mean = x * _horner(self.f0_int, x).real + self.f0_m1
+        e1 = cmath.exp(1j * (self.w.theta0 - self.w.rho * self.w.sig * u))
+        e01 = cmath.exp(1j * self.w.theta0)
+        osc = 0j
+        ek, ek0 = 1.0 + 0j, 1.0 + 0j
+        for y, y_m1 in self.yf:
+            ek *= e1
+            ek0 *= e01
+            osc += ek * _horner(y, x) - ek0 * y_m1
+        return 0.5 * self.L * (mean + 2.0 * osc.real)
+
+    def impulses(self, u: float, dur: float) -> tuple[complex, complex]:
+        """(int (N + i F_t) dt (N s), int F_c dt (N s)) from 0 to u (dur s); the second from the
+        momentum balance m dz_G' = (F1 - i m g - a k z + F_c) dt (a c = 0)."""
+        w = self.w
+        x = 2.0 * u / self.L - 1.0
+        th0, th = w.theta0, w.theta0 - w.rho * w.sig * u
+        P = _osc_between(self.d0, 0, self.rs, th0, th, x)
+        for k, c in self.dk.items():
+            P += _osc_between(c, k, self.rs, th0, th, x)
+        P *= 0.5 * self.L
+        return P, w.contact_impulse(u, dur, self._int_n(u) if w.akcr else 0j)
+
+    def _int_n(self, u: float) -> complex:
+        """int n dt from 0 to u (s): sum_k int Q_k e^{i (k + 1) theta} du, Q_-k = conj Q_k."""
+        x = 2.0 * u / self.L - 1.0
+        th0, th = self.w.theta0, self.w.theta0 - self.w.rho * self.w.sig * u
+        out = 0j
+        for k in range(-K_MAX - 1, K_MAX + 1):
+            vals = self.qf[k] if k >= 0 else [q.conjugate() for q in self.qf[-k]]
+            c = _mono(vals)[0] if k in (0, -1) else _mono_fast(vals)
+            out += _osc_between(c, k + 1, self.rs, th0, th, x)
+        return 0.5 * self.L * out
+
+
+def _osc_between(c: list[complex], k: int, rs: float, th0: float, th: float, x: float
+                 ) -> complex:
+    """int_{-1}^{x} c(xi) e^{i k theta(xi)} d xi with theta(xi) = th0 - rs (xi + 1) (so
+    theta(x) = th): polynomial integral for k = 0, else the Levin form."""
+    if k == 0:
+        ci = [cj / (j + 1) for j, cj in enumerate(c)]
+        return x * _horner(ci, x) + _horner(ci, -1.0)
+    y = _levin(c, -k * rs)
+    return cmath.exp(1j * k * th) * _horner(y, x) - cmath.exp(1j * k * th0) * _horner(y, -1.0)
