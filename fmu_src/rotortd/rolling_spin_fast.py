@@ -68,7 +68,7 @@ P_DIRECT = 20
 """Chebyshev nodes along the path in the direct mode."""
 BETA_DIRECT = 4.0
 """Largest turn of the contact angle theta (rad) over a panel of the direct mode."""
-L_MAX = 1.0
+L_MAX = 0.5
 """Largest panel, rad of psi."""
 TOL_PHASE = 1e-14
 """Largest estimated truncation error of a panel in theta, relative to 1 + the turn of theta
