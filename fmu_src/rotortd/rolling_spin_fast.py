@@ -51,19 +51,22 @@ from __future__ import annotations
 import cmath
 import math
 from operator import mul
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .wall import ContactTally, SegmentEnd
 
 if TYPE_CHECKING:
     from .spin_contact import HeldInputs
 
-P_CHEB = 10
+P_CHEB = 8
 """Chebyshev nodes in u of the Fourier-Levin panel."""
-N_GRID = 16
-"""Points of the DFT in theta."""
-K_MAX = 6
-"""Harmonics in theta kept (|k| <= K_MAX); K_MAX + 1, K_MAX + 2 are computed as the check."""
+P_CHEB_FINE = 12
+"""The same when P_CHEB nodes do not meet TOL_PHASE (at low speed the potential modulates
+the harmonics in psi by eps = 2 c_r |G|/K, 3e-3 at 60 rad/s for the chapter's rotor)."""
+N_GRID = 14
+"""Points of the DFT in beta."""
+K_MAX = 5
+"""Harmonics in beta kept (|j| <= K_MAX); +-(K_MAX + 1) are computed as the check."""
 P_DIRECT = 20
 """Chebyshev nodes along the path in the direct mode."""
 BETA_DIRECT = 4.0
@@ -101,15 +104,16 @@ def _cheb_tables(p: int) -> tuple[list[float], list[list[float]], list[list[floa
     return xs, ch, tm
 
 
-_XL, _CHL, _TML = _cheb_tables(P_CHEB)
-_MXL = [[sum(map(mul, row_j, col)) for col in zip(*_CHL)] for row_j in _TML]
-"""Values at _XL -> monomial coefficients in one product (row j: x^j)."""
+_CHEB = {p: _cheb_tables(p) for p in (P_CHEB, P_CHEB_FINE)}
+_MX = {p: [[sum(map(mul, row_j, col)) for col in zip(*ch)] for row_j in tm]
+       for p, (_, ch, tm) in _CHEB.items()}
+"""Values at the nodes -> monomial coefficients in one product (row j: x^j)."""
 _XD, _CHD, _ = _cheb_tables(P_DIRECT)
-_TH = [2.0 * math.pi * j / N_GRID for j in range(N_GRID)]
-_CT = [math.cos(a) for a in _TH]
-_ST = [math.sin(a) for a in _TH]
-_EM = [[cmath.exp(-1j * k * a) / N_GRID for a in _TH] for k in range(-K_MAX - 1, K_MAX + 3)]
-"""_EM[k + K_MAX + 1][l] = e^{-i k theta_l}/N: the DFT rows, k = -K_MAX-1 .. K_MAX+2."""
+_BG = [2.0 * math.pi * j / N_GRID for j in range(N_GRID)]
+_CB = [math.cos(a) for a in _BG]
+_SB = [math.sin(a) for a in _BG]
+_EM = [[cmath.exp(-1j * k * a) / N_GRID for a in _BG] for k in range(-K_MAX - 1, K_MAX + 2)]
+"""_EM[k + K_MAX + 1][l] = e^{-i k beta_l}/N: the DFT rows, k = -K_MAX-1 .. K_MAX+1."""
 
 
 def _row(k: int) -> list[complex]:
@@ -174,6 +178,14 @@ class DryWhirl:
         dW = (T - B * rn - A * Fot) / IP
         return 1.0 / math.sqrt(om2), rn + m * B * dW, Fot + m * A * dW, om2
 
+    def _speed(self, u: float) -> float:
+        """|Omega| (rad/s) on the path at u, from the energy integral."""
+        th = self.theta0 - self.rho * self.sig * u
+        dv, cE, sE = self._dv_psi(u)
+        ct, st = math.cos(th), math.sin(th)
+        IP = self.I0 - self.c2 * (cE * ct + sE * st)
+        return math.sqrt((self.K0 - 2.0 * (dv - self.c_r * (self.Gx * ct + self.Gy * st))) / IP)
+
     def _path(self, u: float) -> tuple[float, float, float, float, float]:
         """(F, N, F_t, Omega^2, theta) on the path at u."""
         th = self.theta0 - self.rho * self.sig * u
@@ -224,32 +236,47 @@ class DryWhirl:
             return None
         L = min(L_MAX, rem * math.sqrt(hi) * (1.0 + 1e-9))
         direct = self.rho * L <= BETA_DIRECT if levin is None else not levin
-        if not direct:
-            L = max(L, 2.0 * (P_CHEB + 1) / self.rho)
-            if L > L_MAX:
-                return None
-        work = SAMPLE_WORK * (P_DIRECT + 2 * NEWTON_ITERS if direct
-                           else P_CHEB * N_GRID + 2 * NEWTON_ITERS)
-        if work > limit:
+        if not direct and max(L, 2.0 * (P_CHEB + 1) / (1.0 + self.rho)) > L_MAX:
             return None
-        lo, hi = self._omega2_bounds(L)
-        if not self._no_event(lo, hi):
+        most = P_DIRECT if direct else (P_CHEB + P_CHEB_FINE) * (N_GRID + 1)
+        if SAMPLE_WORK * (most + 2 * NEWTON_ITERS) > limit:
             return None
-        tol_t = TOL_PHASE * (1.0 + self.rho * L) / (self.rho * math.sqrt(lo))
-        panel = _DirectPanel(self, L) if direct else _LevinPanel(self, L)
-        if not panel.error_estimate() <= tol_t:
+        self.samples = 0
+        panel = self._panel(L, direct)
+        if panel is None:
             return None
+        L = panel.L
+        work = SAMPLE_WORK * (self.samples + 2 * NEWTON_ITERS)
         if panel.t(L) <= rem:
             u, dur = L, panel.t(L)
         else:
             u, dur = self._newton(panel, rem, L), rem
         return self._end(panel, u, dur, work, step0)
 
+    def _panel(self, L: float, direct: bool) -> _DirectPanel | _LevinPanel | None:
+        """The panel of at least L (rad of psi) whose events are excluded and whose error
+        estimate meets TOL_PHASE: direct, or Fourier-Levin with P_CHEB nodes, then
+        P_CHEB_FINE (the Levin panel is at least 2 (p + 1)/(1 + rho) long, so that its
+        recurrence does not amplify); None if there is none."""
+        for p in ((P_DIRECT,) if direct else (P_CHEB, P_CHEB_FINE)):
+            Lp = L if direct else max(L, 2.0 * (p + 1) / (1.0 + self.rho))
+            if Lp > L_MAX:
+                return None
+            lo, hi = self._omega2_bounds(Lp)
+            if not self._no_event(lo, hi):
+                return None
+            panel = _DirectPanel(self, Lp) if direct else _LevinPanel(self, Lp, p)
+            self.samples += p if direct else p * (N_GRID + 1)
+            if panel.error_estimate() <= TOL_PHASE * (1.0 + self.rho * Lp) / (
+                    self.rho * math.sqrt(lo)):
+                return panel
+        return None
+
     def _newton(self, panel: _DirectPanel | _LevinPanel, rem: float, L: float) -> float:
         """The root u in [0, L] of t(u) = rem (t increasing, t' = F on the path)."""
         u = min(L, rem * abs(self.Omega0))
         for _ in range(NEWTON_ITERS):
-            du = (panel.t(u) - rem) / self._path(u)[0]
+            du = (panel.t(u) - rem) * self._speed(u)
             u = min(L, max(0.0, u - du))
             if abs(du) <= 2.0 * math.ulp(u):
                 break
@@ -279,18 +306,24 @@ class DryWhirl:
                           psi=self.psi0 + self.sig * u, Omega=Om, work=work)
 
 
-def _clenshaw_int(a: list[complex], x: float) -> complex:
-    """int_{-1}^{x} sum_m a_m T_m(xi) d xi (a_0 not halved)."""
+def _cheb_int(a: list[Any]) -> list[Any]:
+    """Chebyshev coefficients of int_{-1}^{x} sum_m a_m T_m(xi) d xi (a_0 not halved)."""
     p = len(a)
-    b = [0j] * (p + 1)
-    b[1] = a[0] - (a[2] if p > 2 else 0.0) / 2.0
+    a = [*a, 0.0, 0.0]
+    b = [0.0 * a[0]] * (p + 1)
+    b[1] = a[0] - a[2] / 2.0
     for m in range(2, p + 1):
-        b[m] = ((a[m - 1] if m - 1 < p else 0.0) - (a[m + 1] if m + 1 < p else 0.0)) / (2 * m)
-    b[0] = -sum(bm * (-1) ** m for m, bm in enumerate(b) if m)
-    # Clenshaw
-    bk1 = bk2 = 0j
-    for m in range(p, 0, -1):
-        bk1, bk2 = 2.0 * x * bk1 - bk2 + b[m], bk1
+        b[m] = (a[m - 1] - a[m + 1]) / (2 * m)
+    b[0] = sum(bm if m % 2 else -bm for m, bm in enumerate(b) if m)  # value 0 at -1
+    return b
+
+
+def _clenshaw(b: list[Any], x: float) -> Any:
+    """sum_m b_m T_m(x)."""
+    bk1 = bk2 = 0.0 * b[0]
+    x2 = 2.0 * x
+    for bm in reversed(b[1:]):
+        bk1, bk2 = x2 * bk1 - bk2 + bm, bk1
     return x * bk1 - bk2 + b[0]
 
 
@@ -312,6 +345,7 @@ class _DirectPanel:
         self.af = [sum(map(mul, fs, row)) for row in _CHD]
         self.ad = [sum(map(mul, ds, row)) for row in _CHD]
         self.an = [sum(map(mul, ns, row)) for row in _CHD] if w.akcr else []
+        self.bf = _cheb_int(self.af)
         self.scale_d = max(abs(d) for d in ds)
 
     def error_estimate(self) -> float:
@@ -325,29 +359,30 @@ class _DirectPanel:
         return ef if ed <= TOL_IMPULSE * self.scale_d else math.inf
 
     def t(self, u: float) -> float:
-        return 0.5 * self.L * _clenshaw_int(self.af, 2.0 * u / self.L - 1.0).real
+        return 0.5 * self.L * _clenshaw(self.bf, 2.0 * u / self.L - 1.0)
 
     def impulses(self, u: float, dur: float) -> tuple[complex, complex]:
         """(int (N + i F_t) dt (N s), int F_c dt (N s)) from 0 to u (dur s); the second
         from the momentum balance (``DryWhirl.contact_impulse``)."""
         x = 2.0 * u / self.L - 1.0
-        int_n = 0.5 * self.L * _clenshaw_int(self.an, x) if self.an else 0j
-        return (0.5 * self.L * _clenshaw_int(self.ad, x),
+        int_n = 0.5 * self.L * _clenshaw(_cheb_int(self.an), x) if self.an else 0j
+        return (0.5 * self.L * _clenshaw(_cheb_int(self.ad), x),
                 self.w.contact_impulse(u, dur, int_n))
 
 
 def _mono(vals: list[complex]) -> tuple[list[complex], float]:
-    """Monomial coefficients in x in [-1, 1] of the interpolant of vals at _XL through its
-    Chebyshev coefficients (rounding a few eps of max |vals|), and the size of its Chebyshev
-    tail |a_{p-1}| + |a_{p-2}|."""
-    a = [sum(map(mul, vals, row)) for row in _CHL]
-    return [sum(map(mul, a, row)) for row in _TML], abs(a[-1]) + abs(a[-2])
+    """Monomial coefficients in x in [-1, 1] of the interpolant of vals at the Chebyshev
+    nodes (len(vals) of them) through its Chebyshev coefficients (rounding a few eps of
+    max |vals|), and the size of its Chebyshev tail |a_{p-1}| + |a_{p-2}|."""
+    _, ch, tm = _CHEB[len(vals)]
+    a = [sum(map(mul, vals, row)) for row in ch]
+    return [sum(map(mul, a, row)) for row in tm], abs(a[-1]) + abs(a[-2])
 
 
 def _mono_fast(vals: list[complex]) -> list[complex]:
-    """The same in one product (_MXL; its rounding is up to ~700 eps of max |vals| at
-    P_CHEB = 10: used for the harmonics k != 0, whose integrals are small)."""
-    return [sum(map(mul, vals, row)) for row in _MXL]
+    """The same in one product (_MX; its rounding is up to ~140 eps of max |vals| at
+    P_CHEB = 8, 3500 at 12: used for the harmonics j != 0, whose integrals are small)."""
+    return [sum(map(mul, vals, row)) for row in _MX[len(vals)]]
 
 
 def _levin(c: list[complex], w: float) -> list[complex]:
@@ -371,36 +406,39 @@ def _horner(c: list[complex], x: float) -> complex:
 
 
 class _LevinPanel:
-    """The Fourier-Levin form of the panel [0, L] (module docstring): the harmonics Q_k of F
-    and D_k of D = (N + i F_t) F in theta, at P_CHEB Chebyshev nodes in u."""
+    """The Fourier-Levin form of the panel [0, L] (module docstring): the harmonics R_j of F
+    and D_j of D = (N + i F_t) F in beta at fixed psi, at P_CHEB Chebyshev nodes in u. (In
+    beta rather than theta: I_P depends on beta alone, so the harmonics' dependence on psi
+    comes only from the potential, of relative size eps = 2 c_r |G|/K; in theta it would
+    come from I_P, of relative size delta = c2/I0.)"""
 
-    def __init__(self, w: DryWhirl, L: float) -> None:
+    def __init__(self, w: DryWhirl, L: float, p: int) -> None:
         self.L, self.w = L, w
-        m, e_c, rho, c_r = w.m, w.e_c, w.rho, w.c_r
-        cen, K0, I0, c2, akcr = m * c_r * rho * rho, w.K0, w.I0, w.c2, w.akcr
-        R, Gx, Gy, T0 = w.R, w.Gx, w.Gy, w.T
-        gr = [Gx * c + Gy * s for c, s in zip(_CT, _ST)]  # Re(conj(n) G) on the grid
-        gi = [Gy * c - Gx * s for c, s in zip(_CT, _ST)]  # Im(conj(n) G)
-        vt = [2.0 * c_r * g for g in gr]  # -2 (theta part of V) on the grid
-        rows_f = [_row(k) for k in range(K_MAX + 3)]
+        m, e_c, c_r, akcr = w.m, w.e_c, w.c_r, w.akcr
+        cen, Gx, Gy, T0 = m * c_r * w.rho * w.rho, w.Gx, w.Gy, w.T
+        ip = [w.I0 - w.c2 * c for c in _CB]  # I_P on the grid
+        Bs = [e_c * s for s in _SB]
+        As = [w.R - e_c * c for c in _CB]
+        rows_f = [_row(k) for k in range(K_MAX + 2)]
         rows_d = [_row(k) for k in range(-K_MAX - 1, K_MAX + 2)]
         qf: list[list[complex]] = [[] for _ in rows_f]
         qd: list[list[complex]] = [[] for _ in rows_d]
-        us = [0.5 * L * (1.0 + x) for x in _XL]
+        us = [0.5 * L * (1.0 + x) for x in _CHEB[p][0]]
+        Es = []
         for u in us:
             dv, cE, sE = w._dv_psi(u)
-            base = K0 - 2.0 * dv
+            Es.append(complex(cE, sE))
+            base = w.K0 - 2.0 * dv
             T = T0 + e_c * (w.F1x * sE - w.F1y * cE)
             fs, ds = [], []
-            for ct, st, g_r, g_i, v in zip(_CT, _ST, gr, gi, vt):
-                cb, sb = cE * ct + sE * st, sE * ct - cE * st
-                IP = I0 - c2 * cb
-                om2 = (base + v) / IP
+            for cb, sb, IP, B, A in zip(_CB, _SB, ip, Bs, As):
+                ct, st = cE * cb + sE * sb, sE * cb - cE * sb  # theta = psi + phi - beta
+                g_r, g_i = Gx * ct + Gy * st, Gy * ct - Gx * st  # conj(n) G
+                om2 = (base + 2.0 * c_r * g_r) / IP
                 F = 1.0 / math.sqrt(om2)
                 U = m * e_c * om2
                 rn = g_r - akcr + U * cb + cen * om2
                 Fot = g_i + U * sb
-                B, A = e_c * sb, R - e_c * cb
                 dW = (T - akcr * B - B * rn - A * Fot) / IP
                 fs.append(F)
                 ds.append(complex((rn + m * B * dW) * F, (Fot + m * A * dW) * F))
@@ -408,43 +446,45 @@ class _LevinPanel:
                 q.append(sum(map(mul, fs, row)))
             for q, row in zip(qd, rows_d):
                 q.append(sum(map(mul, ds, row)))
-        self.us = us
+        self.us, self.Es = us, Es
         self.Ns = [abs(w._path(u)[1]) for u in us]  # N on the path at the nodes
-        rs = rho * w.sig * 0.5 * L  # w_k = -k rs: the frequency of harmonic k in x
-        self.rs = rs
+        self.b0 = w.psi0 + w.phi - w.theta0
+        self.rs = rs = (1.0 + w.rho) * w.sig * 0.5 * L  # w_j = j rs: harmonic j's frequency in x
         f0, t0 = _mono(qf[0])
         f1 = _mono(qf[1])[1]
         self.f0_int = [cj.real / (j + 1) for j, cj in enumerate(f0)]
         self.f0_m1 = _horner(self.f0_int, -1.0).real
         self.yf = []
-        for k in range(1, K_MAX + 1):
-            y = _levin(_mono_fast(qf[k]), -k * rs)
+        for j in range(1, K_MAX + 1):
+            y = _levin(_mono_fast(qf[j]), j * rs)
             self.yf.append((y, _horner(y, -1.0)))
         self.qf = qf
-        hi = sum(2.0 * max(abs(q) for q in qf[k]) * 2.0 / (k * rho)
-                 for k in (K_MAX + 1, K_MAX + 2))
+        k1 = K_MAX + 1
+        hi = 2.0 * max(abs(q) for q in qf[k1]) * 2.0 / (k1 * abs(rs) * 2.0 / L)
         self.est = 0.5 * L * 2.0 * (t0 + f1) + hi
-        d = {k: q for k, q in zip(range(-K_MAX - 1, K_MAX + 2), qd)}
+        d = dict(zip(range(-K_MAX - 1, K_MAX + 2), qd))
         self.d0 = _mono(d[0])[0]
-        self.dk = {k: _mono_fast(d[k]) for k in range(-K_MAX, K_MAX + 1) if k}
+        self.dk = {j: _mono_fast(d[j]) for j in range(-K_MAX, K_MAX + 1) if j}
         scale_d = max(abs(q) for q in d[0]) * L
-        hi_d = sum(max(abs(q) for q in d[k]) * 2.0 / ((K_MAX + 1) * rho)
-                   for k in (-K_MAX - 1, K_MAX + 1))
+        hi_d = sum(max(abs(q) for q in d[j]) * 2.0 / (k1 * abs(rs) * 2.0 / L)
+                   for j in (-k1, k1))
         self.d_ok = hi_d <= TOL_IMPULSE * scale_d
 
     def error_estimate(self) -> float:
-        """Estimated error of t over the panel (s): the Chebyshev tails of Q_0 and Q_1 over
-        the panel and the dropped harmonics K_MAX + 1, K_MAX + 2 (their oscillatory
-        integrals, 2 |Q_k|/(k rho) each, both signs); inf when the impulses' first dropped
-        harmonics (K_MAX + 1, both signs) integrate to above TOL_IMPULSE of their mean over
-        the panel."""
+        """Estimated error of t over the panel (s): the Chebyshev tails of R_0 and R_1 over
+        the panel and the dropped harmonics +-(K_MAX + 1) (their oscillatory integrals,
+        2 |R_j|/(j (1 + rho)) each); inf when the impulses' first dropped harmonics
+        integrate to above TOL_IMPULSE of their mean over the panel."""
         return self.est if self.d_ok else math.inf
+
+    def _beta(self, u: float) -> float:
+        return self.b0 + (1.0 + self.w.rho) * self.w.sig * u
 
     def t(self, u: float) -> float:
         x = 2.0 * u / self.L - 1.0
         mean = x * _horner(self.f0_int, x).real + self.f0_m1
-        e1 = cmath.exp(1j * (self.w.theta0 - self.w.rho * self.w.sig * u))
-        e01 = cmath.exp(1j * self.w.theta0)
+        e1 = cmath.exp(1j * self._beta(u))
+        e01 = cmath.exp(1j * self.b0)
         osc = 0j
         ek, ek0 = 1.0 + 0j, 1.0 + 0j
         for y, y_m1 in self.yf:
@@ -454,35 +494,36 @@ class _LevinPanel:
         return 0.5 * self.L * (mean + 2.0 * osc.real)
 
     def impulses(self, u: float, dur: float) -> tuple[complex, complex]:
-        """(int (N + i F_t) dt (N s), int F_c dt (N s)) from 0 to u (dur s); the second from the
-        momentum balance m dz_G' = (F1 - i m g - a k z + F_c) dt (a c = 0)."""
-        w = self.w
+        """(int (N + i F_t) dt (N s), int F_c dt (N s)) from 0 to u (dur s); the second from
+        the momentum balance (``DryWhirl.contact_impulse``)."""
         x = 2.0 * u / self.L - 1.0
-        th0, th = w.theta0, w.theta0 - w.rho * w.sig * u
-        P = _osc_between(self.d0, 0, self.rs, th0, th, x)
-        for k, c in self.dk.items():
-            P += _osc_between(c, k, self.rs, th0, th, x)
+        b0, b = self.b0, self._beta(u)
+        P = _osc_between(self.d0, 0, self.rs, b0, b, x)
+        for j, c in self.dk.items():
+            P += _osc_between(c, j, self.rs, b0, b, x)
         P *= 0.5 * self.L
-        return P, w.contact_impulse(u, dur, self._int_n(u) if w.akcr else 0j)
+        return P, self.w.contact_impulse(u, dur, self._int_n(u) if self.w.akcr else 0j)
 
     def _int_n(self, u: float) -> complex:
-        """int n dt from 0 to u (s): sum_k int Q_k e^{i (k + 1) theta} du, Q_-k = conj Q_k."""
+        """int n dt from 0 to u (s): n = E e^{-i beta}, so sum_j int R_j E e^{i (j - 1) beta} du
+        (R_-j = conj R_j; E slow, taken into the interpolated values)."""
         x = 2.0 * u / self.L - 1.0
-        th0, th = self.w.theta0, self.w.theta0 - self.w.rho * self.w.sig * u
+        b0, b = self.b0, self._beta(u)
         out = 0j
-        for k in range(-K_MAX - 1, K_MAX + 1):
-            vals = self.qf[k] if k >= 0 else [q.conjugate() for q in self.qf[-k]]
-            c = _mono(vals)[0] if k in (0, -1) else _mono_fast(vals)
-            out += _osc_between(c, k + 1, self.rs, th0, th, x)
+        for j in range(-K_MAX, K_MAX + 2):
+            q = self.qf[j] if j >= 0 else [v.conjugate() for v in self.qf[-j]]
+            vals = [v * E for v, E in zip(q, self.Es)]
+            c = _mono(vals)[0] if j in (0, 1) else _mono_fast(vals)
+            out += _osc_between(c, j - 1, self.rs, b0, b, x)
         return 0.5 * self.L * out
 
 
-def _osc_between(c: list[complex], k: int, rs: float, th0: float, th: float, x: float
+def _osc_between(c: list[complex], k: int, rs: float, b0: float, b: float, x: float
                  ) -> complex:
-    """int_{-1}^{x} c(xi) e^{i k theta(xi)} d xi with theta(xi) = th0 - rs (xi + 1) (so
-    theta(x) = th): polynomial integral for k = 0, else the Levin form."""
+    """int_{-1}^{x} c(xi) e^{i k beta(xi)} d xi with beta(xi) = b0 + rs (xi + 1) (so
+    beta(x) = b): polynomial integral for k = 0, else the Levin form."""
     if k == 0:
         ci = [cj / (j + 1) for j, cj in enumerate(c)]
         return x * _horner(ci, x) + _horner(ci, -1.0)
-    y = _levin(c, -k * rs)
-    return cmath.exp(1j * k * th) * _horner(y, x) - cmath.exp(1j * k * th0) * _horner(y, -1.0)
+    y = _levin(c, k * rs)
+    return cmath.exp(1j * k * b) * _horner(y, x) - cmath.exp(1j * k * b0) * _horner(y, -1.0)
