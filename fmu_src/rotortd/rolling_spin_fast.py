@@ -60,11 +60,15 @@ if TYPE_CHECKING:
 
 P_CHEB = 8
 """Chebyshev nodes in u of the Fourier-Levin panel."""
+P_CHEB_COARSE = 6
+"""The same, tried first when the potential's relative variation over the panel
+(2 c_r |G| + 2 m g e_c + |T_drive| L_MAX)/K0 is below MOD_COARSE (at speed)."""
+MOD_COARSE = 1e-7
 P_CHEB_FINE = 12
 """The same when P_CHEB nodes do not meet TOL_PHASE (at low speed the potential modulates
 the harmonics in psi by eps = 2 c_r |G|/K, 3e-3 at 60 rad/s for the chapter's rotor)."""
-N_GRID = 14
-"""Points of the DFT in beta."""
+N_GRID = 13
+"""Points of the DFT in beta (odd: harmonic +-(K_MAX + 1) is not the Nyquist one)."""
 K_MAX = 5
 """Harmonics in beta kept (|j| <= K_MAX); +-(K_MAX + 1) are computed as the check."""
 P_DIRECT = 20
@@ -104,7 +108,7 @@ def _cheb_tables(p: int) -> tuple[list[float], list[list[float]], list[list[floa
     return xs, ch, tm
 
 
-_CHEB = {p: _cheb_tables(p) for p in (P_CHEB, P_CHEB_FINE)}
+_CHEB = {p: _cheb_tables(p) for p in (P_CHEB_COARSE, P_CHEB, P_CHEB_FINE)}
 _MX = {p: [[sum(map(mul, row_j, col)) for col in zip(*ch)] for row_j in tm]
        for p, (_, ch, tm) in _CHEB.items()}
 """Values at the nodes -> monomial coefficients in one product (row j: x^j)."""
@@ -238,7 +242,7 @@ class DryWhirl:
         direct = self.rho * L <= BETA_DIRECT if levin is None else not levin
         if not direct and max(L, 2.0 * (P_CHEB + 1) / (1.0 + self.rho)) > L_MAX:
             return None
-        most = P_DIRECT if direct else (P_CHEB + P_CHEB_FINE) * (N_GRID + 1)
+        most = P_DIRECT if direct else (P_CHEB_COARSE + P_CHEB + P_CHEB_FINE) * (N_GRID + 1)
         if SAMPLE_WORK * (most + 2 * NEWTON_ITERS) > limit:
             return None
         self.samples = 0
@@ -258,7 +262,10 @@ class DryWhirl:
         estimate meets TOL_PHASE: direct, or Fourier-Levin with P_CHEB nodes, then
         P_CHEB_FINE (the Levin panel is at least 2 (p + 1)/(1 + rho) long, so that its
         recurrence does not amplify); None if there is none."""
-        for p in ((P_DIRECT,) if direct else (P_CHEB, P_CHEB_FINE)):
+        mod = (2.0 * self.c_r * math.hypot(self.Gx, self.Gy) + 2.0 * self.mge
+               + abs(self.T) * L_MAX) / self.K0
+        ps = (P_CHEB, P_CHEB_FINE) if mod > MOD_COARSE else (P_CHEB_COARSE, P_CHEB, P_CHEB_FINE)
+        for p in ((P_DIRECT,) if direct else ps):
             Lp = L if direct else max(L, 2.0 * (p + 1) / (1.0 + self.rho))
             if Lp > L_MAX:
                 return None
