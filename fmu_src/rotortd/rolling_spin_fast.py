@@ -64,6 +64,9 @@ P_CHEB_COARSE = 6
 """The same, tried first when the potential's relative variation over the panel
 (2 c_r |G| + 2 m g e_c + |T_drive| L_MAX)/K0 is below MOD_COARSE (at speed)."""
 MOD_COARSE = 1e-7
+MOD_FINE = 1e-4
+"""Above this relative variation, P_CHEB_FINE nodes at once (P_CHEB would not meet the
+tolerance: at 60 rad/s it is 2e-3 for the chapter's rotor)."""
 P_CHEB_FINE = 12
 """The same when P_CHEB nodes do not meet TOL_PHASE (at low speed the potential modulates
 the harmonics in psi by eps = 2 c_r |G|/K, 3e-3 at 60 rad/s for the chapter's rotor)."""
@@ -264,7 +267,8 @@ class DryWhirl:
         recurrence does not amplify); None if there is none."""
         mod = (2.0 * self.c_r * math.hypot(self.Gx, self.Gy) + 2.0 * self.mge
                + abs(self.T) * L_MAX) / self.K0
-        ps = (P_CHEB, P_CHEB_FINE) if mod > MOD_COARSE else (P_CHEB_COARSE, P_CHEB, P_CHEB_FINE)
+        ps = ((P_CHEB_FINE,) if mod > MOD_FINE else (P_CHEB, P_CHEB_FINE) if mod > MOD_COARSE
+              else (P_CHEB_COARSE, P_CHEB, P_CHEB_FINE))
         for p in ((P_DIRECT,) if direct else ps):
             Lp = L if direct else max(L, 2.0 * (p + 1) / (1.0 + self.rho))
             if Lp > L_MAX:
