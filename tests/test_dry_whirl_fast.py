@@ -127,15 +127,14 @@ def test_declines_where_an_event_is_not_excluded() -> None:
 
 
 def test_work_does_not_grow_with_the_speed() -> None:
-    """The Fourier-Levin panel's work does not grow with the speed (it falls to fewer nodes
-    where the potential barely varies); beyond L_MAX rad of psi per call the panel ends
-    first (the step loop takes another)."""
+    """The Fourier-Levin panel's work does not grow with the speed; beyond L_MAX rad of psi
+    per call the panel ends first (the step loop takes another)."""
     works = []
     for W in (700.0, 2000.0, 6000.0, 1e5):
         end = DryWhirl(_held(), TH0, PSI0, W).advance(H, 10 ** 9)
         assert end is not None
         works.append(end.work)
-        assert end.duration == H or (end.duration < H and abs(end.psi - PSI0) > 0.49)
+        assert end.duration == H or (end.duration < H and abs(end.psi - PSI0) > 0.99)
     assert works == sorted(works, reverse=True), works
 
 

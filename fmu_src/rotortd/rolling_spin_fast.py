@@ -60,13 +60,10 @@ if TYPE_CHECKING:
 
 P_CHEB = 8
 """Chebyshev nodes in u of the Fourier-Levin panel."""
-P_CHEB_COARSE = 6
-"""The same, tried first when the potential's relative variation over the panel
-(2 c_r |G| + 2 m g e_c + |T_drive| L_MAX)/K0 is below MOD_COARSE (at speed)."""
-MOD_COARSE = 1e-7
 MOD_FINE = 1e-4
-"""Above this relative variation, P_CHEB_FINE nodes at once (P_CHEB would not meet the
-tolerance: at 60 rad/s it is 2e-3 for the chapter's rotor)."""
+"""Above this relative variation of the potential over the panel,
+(2 c_r |G| + 2 m g e_c + |T_drive| L_MAX)/K0, P_CHEB_FINE nodes at once (P_CHEB would not
+meet the tolerance: at 60 rad/s it is 2e-3 for the chapter's rotor)."""
 P_CHEB_FINE = 12
 """The same when P_CHEB nodes do not meet TOL_PHASE (at low speed the potential modulates
 the harmonics in psi by eps = 2 c_r |G|/K, 3e-3 at 60 rad/s for the chapter's rotor)."""
@@ -78,7 +75,7 @@ P_DIRECT = 20
 """Chebyshev nodes along the path in the direct mode."""
 BETA_DIRECT = 4.0
 """Largest turn of the contact angle theta (rad) over a panel of the direct mode."""
-L_MAX = 0.5
+L_MAX = 1.0
 """Largest panel, rad of psi."""
 TOL_PHASE = 1e-14
 """Largest estimated truncation error of a panel in theta, relative to 1 + the turn of theta
@@ -111,7 +108,7 @@ def _cheb_tables(p: int) -> tuple[list[float], list[list[float]], list[list[floa
     return xs, ch, tm
 
 
-_CHEB = {p: _cheb_tables(p) for p in (P_CHEB_COARSE, P_CHEB, P_CHEB_FINE)}
+_CHEB = {p: _cheb_tables(p) for p in (P_CHEB, P_CHEB_FINE)}
 _MX = {p: [[sum(map(mul, row_j, col)) for col in zip(*ch)] for row_j in tm]
        for p, (_, ch, tm) in _CHEB.items()}
 """Values at the nodes -> monomial coefficients in one product (row j: x^j)."""
@@ -245,7 +242,7 @@ class DryWhirl:
         direct = self.rho * L <= BETA_DIRECT if levin is None else not levin
         if not direct and max(L, 2.0 * (P_CHEB + 1) / (1.0 + self.rho)) > L_MAX:
             return None
-        most = P_DIRECT if direct else (P_CHEB_COARSE + P_CHEB + P_CHEB_FINE) * (N_GRID + 1)
+        most = P_DIRECT if direct else (P_CHEB + P_CHEB_FINE) * (N_GRID + 1)
         if SAMPLE_WORK * (most + 2 * NEWTON_ITERS) > limit:
             return None
         self.samples = 0
@@ -267,8 +264,7 @@ class DryWhirl:
         recurrence does not amplify); None if there is none."""
         mod = (2.0 * self.c_r * math.hypot(self.Gx, self.Gy) + 2.0 * self.mge
                + abs(self.T) * L_MAX) / self.K0
-        ps = ((P_CHEB_FINE,) if mod > MOD_FINE else (P_CHEB, P_CHEB_FINE) if mod > MOD_COARSE
-              else (P_CHEB_COARSE, P_CHEB, P_CHEB_FINE))
+        ps = (P_CHEB_FINE,) if mod > MOD_FINE else (P_CHEB, P_CHEB_FINE)
         for p in ((P_DIRECT,) if direct else ps):
             Lp = L if direct else max(L, 2.0 * (p + 1) / (1.0 + self.rho))
             if Lp > L_MAX:
