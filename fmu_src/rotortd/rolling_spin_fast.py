@@ -14,35 +14,38 @@ force does no work and the spring force -a k z none on the circle, so
     1/2 I_P(beta) Omega^2 + V(theta, psi) = const,   I_P = J + m (R^2 + e_c^2 - 2 R e_c cos beta),
     V = -c_r Re(conj(G) n) + m g e_c sin(psi + phi) - T_drive psi,   G = a F_bias + F_ext - i m g,
 
-and the time is the quadrature dt = du / |Omega| = F(theta(u), psi(u)) du with
-F(theta, psi) = sqrt(I_P / (K0 - 2 (V - V0))), K0 = I_P(beta0) Omega0^2, a smooth function on
-the torus (theta, psi) for psi in the panel.
+and the time is the quadrature dt = du / |Omega| = F(beta(u), psi(u)) du with
+F = sqrt(I_P / (K0 - 2 (V - V0))) (s/rad), K0 = I_P(beta0) Omega0^2, a smooth function on
+the torus (beta, psi) for psi in the panel (theta = psi + phi - beta).
 
 Two ways to evaluate t(u) = int_0^u F du on a panel u in [0, L] (L <= L_MAX rad of psi):
 
 - direct (the contact angle turns by at most BETA_DIRECT rad over the panel): Chebyshev
   interpolation of F along the path at P_DIRECT nodes, integrated exactly;
-- Fourier-Levin (any speed): F(theta, psi) = sum_k Q_k(psi) e^{i k theta}, the Q_k from an
-  N_GRID-point DFT in theta at P_CHEB Chebyshev nodes in u; on the path e^{i k theta(u)} =
-  e^{i k theta0} e^{-i k rho sigma u}, and int Q_k(u) e^{-i k rho sigma u} du = [y_k(u)
-  e^{-i k rho sigma u}] with y_k the polynomial solution of y' - i k rho sigma y = Q_k
-  (backward recurrence on its monomial coefficients, stable when |k| rho L/2 > P_CHEB). So
-  t(u) = mean part (k = 0, a polynomial) + the periodic remainder at the two ends: a fixed
-  amount of work, whatever the number of turns of beta in the panel.
+- Fourier-Levin (any speed): F(beta, psi) = sum_j R_j(psi) e^{i j beta}, the R_j from an
+  N_GRID-point DFT in beta at P_CHEB Chebyshev nodes in u (in beta, I_P adds no dependence
+  on psi: the R_j vary only with the potential, by eps = 2 c_r |G|/K per radian, which
+  vanishes at speed); on the path e^{i j beta(u)} = e^{i j beta0} e^{i j (1 + rho) sigma u},
+  and int R_j(u) e^{i w u} du = [y_j(u) e^{i w u}] with y_j the polynomial solution of
+  y' + i w y = R_j (backward recurrence on its monomial coefficients, stable when
+  |j| (1 + rho) L/2 > P_CHEB). So t(u) = mean part (j = 0, a polynomial) + the periodic
+  remainder at the two ends: a fixed amount of work, whatever the number of turns of beta
+  in the panel.
 
 The step end is the root of t(u) = rem (Newton with t'(u) = F on the path); the end state
 follows from the energy integral. The impulses int N, int F_t and int F_c of the segment are
-the same quadratures of (N + i F_t) F (and times e^{i theta}).
+the same quadrature of (N + i F_t) F, and the momentum balance for int F_c.
 
-Events: none is allowed in a panel. A panel is taken only when bounds over every (theta,
+Events: none is allowed in a panel. A panel is taken only when bounds over every (beta,
 psi) of the panel and every Omega^2 the energy allows there prove N > 0 and |F_t| < mu N
 (``_no_event``); otherwise ``advance`` returns None and the extrapolation integrator of
 ``spin_contact`` (which locates the event) takes the segment. At speed N is dominated by
 the centripetal term m c_r rho^2 Omega^2, so the bound holds at any speed when
-mu > ~ (e_c/(c_r rho^2) + m R e_c/I_P) (docs/notes/dry-whirl-quadrature.md §4).
+mu > e_c/(c_r rho^2) + m e_c (R + e_c)/I_min (docs/notes/dry-whirl-quadrature.md §4).
 
 Errors (estimated, not enclosed): the truncated harmonics and the Chebyshev tails are
-required below TOL_PHASE rad of theta (converted to time by 1/(rho |Omega|)); otherwise
+required below TOL_PHASE (1 + the turn of theta over the panel) rad of theta (converted to
+time by 1/(rho |Omega|)), those of the impulses below TOL_IMPULSE of their mean; otherwise
 ``advance`` declines (None).
 """
 
