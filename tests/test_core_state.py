@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 from rotortd import ParameterError, RotorParams, SpinCore, TouchdownCore, restore_core
+from rotortd.segments.spin_contact import SpinContact
 from rotortd.step.state import CoreState
 
 W0 = 184.2
@@ -143,9 +144,12 @@ def _v2_states() -> dict[str, dict]:
 
 
 @pytest.mark.parametrize("name", SCENES)
-def test_version_2_states_load(name: str) -> None:
+def test_version_2_states_load(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """A version 2 state made by rotortd at 726b1b4 after a recipe is the state this tree
-    reaches by the same recipe, field for field."""
+    reaches by the same recipe, field for field (with the spin a state, rolling by the
+    integrator that made them: the dry-whirl accelerator, docs/notes/dry-whirl-quadrature.md,
+    agrees with it to about 1e-14, not to the bit)."""
+    monkeypatch.setattr(SpinContact, "accelerate", False)
     v2 = _v2_states()[name]
     assert v2["version"] == 2 and "inputs" in v2 and "H" in v2
     restored = restore_core(v2)

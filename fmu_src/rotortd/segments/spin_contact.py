@@ -39,7 +39,7 @@ from ..contact.events import Event
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
-from . import gbs
+from . import gbs, rolling_spin_fast
 from .roots import illinois
 
 RTOL = 1e-13
@@ -171,6 +171,11 @@ class SpinContact:
     """One contact segment, sliding (s = +-1) or rolling (s = 0), from
     (theta, theta', psi, Omega); in rolling theta' = -R Omega/c_r is implied."""
 
+    accelerate = True
+    """Declared accelerator: rolling with the bearing's damper off (a c = 0) is advanced by
+    its energy integral (``rolling_spin_fast.DryWhirl``, docs/notes/dry-whirl-quadrature.md)
+    where that applies and no event can occur; False: always the integrator below."""
+
     def __init__(self, h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
                  Omega: float, step0: float = math.inf, n_slack: float = 0.0) -> None:
         self.h, self.s = h, s
@@ -232,6 +237,11 @@ class SpinContact:
 
     def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
+        if self.rolling and self.accelerate and rolling_spin_fast.applies(self.h):
+            # declared accelerator (docs/notes/dry-whirl-quadrature.md): None = not here
+            fast = rolling_spin_fast.DryWhirl(self.h, *self.y0).advance(rem, limit, self.step0)
+            if fast is not None:
+                return fast
         y = self.y0 + [0.0] * 5
         nq = self.nq
         u, H, work = 0.0, self.step0, 0

@@ -1,0 +1,211 @@
+"""Cost of dry whirl against the rolling speed: the energy-integral kernel and the integrator.
+
+    python docs/scripts/bench_dry_whirl_speed.py              # ~5 min (callgrind + mpmath)
+    python docs/scripts/bench_dry_whirl_speed.py --no-errors  # instructions only
+
+Issue #26 item 1 (docs/notes/dry-whirl-quadrature.md). The chapter's rotor (g = 9.81,
+J = m R^2/2 = 0.04 kg m^2, ``integrate_spin``: ``SpinCore``) rolls on the fixed race at
+Omega = 60, 200, 600 and 2000 rad/s (theta' = -R Omega/c_r, started in rolling at the bottom
+of the clearance), stepped by ``SpinCore.step`` at 1e-4 s. Per speed:
+
+1. Instructions per 1e-4 s step (valgrind callgrind; the difference of two runs of 10 and 60
+   steps after 5 warm-up steps, in fresh processes with PYTHONHASHSEED = 0, as
+   bench_instructions.py and bench_spin.py count), times 1e4: instructions per simulated
+   second of rolling, for
+   - ``fast``: the bearing off (a = 0), the declared accelerator on (``rolling_spin_fast``:
+     the direct panel where theta turns at most BETA_DIRECT rad per step, else
+     Fourier-Levin);
+   - ``levin``: the same with the Fourier-Levin panel at every speed (BETA_DIRECT < 0);
+   - ``old``: the bearing off, the accelerator off (``SpinContact.accelerate = False``:
+     the extrapolation integrator, at most one radian of beta per step);
+   - ``damper``: the bearing on (amb_on = 1, c = 1400 N s/m: the energy integral does not
+     hold, the integrator runs), for the cost law of that path.
+   Printed with the ratio max/min over the speeds (the issue's target for the kernel: at
+   most 1.5 between 60 and 2000 rad/s) and the exponent of a power law through the first
+   and last speed; ``fast`` and ``levin`` also at 6000 rad/s (not in the ratio).
+2. The error of one 1e-4 s step from (theta, psi) = (-1.3, 0.4) against the 40-digit Taylor
+   integration (tests/reference/spin_mp.py), for ``fast`` and ``old``: theta over
+   (1 + its turn), psi over (1 + its turn), Omega relative, the impulses over
+   max(|int N|, N_peak h) (as tests/test_dry_whirl_fast.py).
+Writes docs/bench_dry_whirl_speed.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(ROOT / "fmu_src"))
+sys.path.insert(1, str(ROOT))
+
+import bench_instructions as BI  # noqa: E402 (docs/scripts: callgrind helpers)
+
+OUT = ROOT / "docs" / "bench_dry_whirl_speed.json"
+SPEEDS = (60.0, 200.0, 600.0, 2000.0)
+EXTRA = 6000.0
+"""A further speed for the kernel alone (fast, levin): where its cost stays."""
+KINDS = ("fast", "levin", "old", "damper")
+H, WARM, N_SHORT, N_LONG = 1e-4, 5, 10, 60
+
+CHILD = '''
+import cmath, math, sys
+from dataclasses import replace
+sys.path.insert(0, sys.argv[1])
+from rotortd import RotorParams, SpinCore, rolling_spin_fast, spin_contact
+kind, W, n = sys.argv[2], float(sys.argv[3]), int(sys.argv[4])
+p = RotorParams(g=9.81)
+J = 0.5 * p.m * p.R ** 2
+spin_contact.SpinContact.accelerate = kind in ("fast", "levin")
+if kind == "levin":
+    rolling_spin_fast.BETA_DIRECT = -1.0
+core = SpinCore(p, J, Omega0=W)
+th, dth = -math.pi / 2, -p.R * W / p.c_r
+nn = cmath.exp(1j * th)
+core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0, z=p.c_r * nn,
+                       v=1j * p.c_r * dth * nn))
+a = 1.0 if kind == "damper" else 0.0
+for _ in range(WARM + n):
+    core.step(H, amb_on=a)
+assert core.mode == 2, (kind, W, core.mode)
+'''.replace("WARM", str(WARM)).replace("H,", f"{H!r},")
+
+
+def sanity(W: float, kind: str) -> tuple[int, int]:
+    """(kernel calls that took a segment, calls that declined) over 5 steps (``fast``,
+    ``levin``) in this process."""
+    import cmath
+    from dataclasses import replace
+
+    from rotortd import RotorParams, SpinCore, rolling_spin_fast, spin_contact
+
+    used = declined = 0
+    orig = rolling_spin_fast.DryWhirl.advance
+
+    def counted(self: Any, *a: Any, **k: Any) -> Any:
+        nonlocal used, declined
+        end = orig(self, *a, **k)
+        used += end is not None
+        declined += end is None
+        return end
+
+    p = RotorParams(g=9.81)
+    core = SpinCore(p, 0.5 * p.m * p.R ** 2, Omega0=W)
+    th, dth = -math.pi / 2, -p.R * W / p.c_r
+    nn = cmath.exp(1j * th)
+    core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0,
+                           z=p.c_r * nn, v=1j * p.c_r * dth * nn))
+    keep = rolling_spin_fast.BETA_DIRECT
+    rolling_spin_fast.DryWhirl.advance = counted  # type: ignore[method-assign]
+    spin_contact.SpinContact.accelerate = True
+    try:
+        if kind == "levin":
+            rolling_spin_fast.BETA_DIRECT = -1.0
+        for _ in range(5):
+            core.step(H, amb_on=0.0)
+    finally:
+        rolling_spin_fast.DryWhirl.advance = orig  # type: ignore[method-assign]
+        rolling_spin_fast.BETA_DIRECT = keep
+    return used, declined
+
+
+def count(speeds: tuple[float, ...] = SPEEDS, kinds: tuple[str, ...] = KINDS
+          ) -> dict[str, dict[str, float]]:
+    out: dict[str, dict[str, float]] = {k: {} for k in kinds}
+    with tempfile.TemporaryDirectory() as tmp:
+        script = Path(tmp) / "child.py"
+        script.write_text(CHILD)
+        src = str(ROOT / "fmu_src")
+        for W in speeds:
+            for kind in kinds:
+                if kind in ("fast", "levin"):
+                    used, declined = sanity(W, kind)
+                    assert used >= 5 and declined == 0, (W, kind, used, declined)
+                per_step = BI.per_unit(script, [src, kind, repr(W)], N_SHORT, N_LONG)
+                out[kind][f"{W:g}"] = per_step / H
+                print(f"{kind:>7} Omega = {W:6g} rad/s: {per_step / 1e3:9.1f} k instructions "
+                      f"per step, {per_step / H / 1e9:7.3f} G per simulated second",
+                      flush=True)
+    return out
+
+
+def summary(ips: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
+    res = {}
+    for kind, row in ips.items():
+        v = list(row.values())
+        lo_w, hi_w = SPEEDS[0], SPEEDS[-1]
+        expo = math.log(row[f"{hi_w:g}"] / row[f"{lo_w:g}"]) / math.log(hi_w / lo_w)
+        res[kind] = {"max_over_min": max(v) / min(v), "power_law_exponent": expo}
+        print(f"{kind:>7}: max/min over the speeds = {max(v) / min(v):5.2f}, "
+              f"cost ~ Omega^{expo:.2f} (60 -> 2000 rad/s)")
+    return res
+
+
+def step_errors() -> dict[str, dict[str, dict[str, float]]]:
+    """Errors of one 1e-4 s step against the 40-digit reference (module docstring, 2.)."""
+    from rotortd import spin_contact
+    from rotortd.params import RotorParams
+    from rotortd.segments.spin_contact import HeldInputs, SpinContact
+
+    from tests.reference.spin_mp import mp_contact
+
+    p = RotorParams(g=9.81)
+    par = {f: getattr(p, f) for f in ("m", "c", "k", "e_c", "phi", "c_r", "R", "mu", "d",
+                                      "g", "levitate")}
+    J, th0, psi0 = 0.5 * p.m * p.R ** 2, -1.3, 0.4
+    mc = p.m * p.c_r
+    out: dict[str, dict[str, dict[str, float]]] = {"fast": {}, "old": {}}
+    for W in SPEEDS:
+        ref = mp_contact(par, J, 0, th0, 0.0, psi0, W, H, a=0.0)
+        for kind in out:
+            seg = SpinContact(HeldInputs(p, J, 0.0, 0j, 0.0), 0.0, th0, 0.0, psi0, W)
+            seg.accelerate = kind == "fast"
+            end = seg.run(H, 10 ** 9)
+            tal = end.tally
+            assert tal is not None
+            S = max(abs(float(ref["P_n"])), mc * tal.peak * H)
+            e = {"theta": abs(end.theta - ref["theta"]) / (1 + abs(end.theta - th0)),
+                 "psi": abs(end.psi - ref["psi"]) / (1 + abs(end.psi - psi0)),
+                 "Omega": abs(end.Omega - ref["Omega"]) / W,
+                 "P_n": abs(mc * tal.I_n - ref["P_n"]) / S,
+                 "P_t": abs(mc * tal.I_t - ref["P_t"]) / S,
+                 "P_c": abs(mc * tal.I_c - ref["P_c"]) / S}
+            out[kind][f"{W:g}"] = {k: float(v) for k, v in e.items()}
+            print(f"error of one step, {kind:>4}, Omega = {W:6g}: max "
+                  f"{max(out[kind][f'{W:g}'].values()):.1e} "
+                  + " ".join(f"{k}={float(v):.1e}" for k, v in e.items()), flush=True)
+        spin_contact.SpinContact.accelerate = True
+    return out
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--no-errors", action="store_true")
+    ap.add_argument("--quick", nargs=2, metavar=("KINDS", "SPEEDS"),
+                    help="count only these (comma-separated), print, write nothing")
+    args = ap.parse_args()
+    if args.quick:
+        count(tuple(float(w) for w in args.quick[1].split(",")),
+              tuple(args.quick[0].split(",")))
+        return 0
+    ips = count()
+    extra = count((EXTRA,), ("fast", "levin"))
+    result: dict[str, Any] = {"instructions_per_simulated_s": ips, "summary": summary(ips),
+                              "kernel_at_6000_rad_s": {k: v[f"{EXTRA:g}"]
+                                                       for k, v in extra.items()}}
+    if not args.no_errors:
+        result["step_error_vs_40_digits"] = step_errors()
+    OUT.write_text(json.dumps(result, indent=1) + "\n")
+    print(f"wrote {OUT.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
