@@ -201,7 +201,9 @@ class SpinFlight:
         self.F0_abs = abs(self.F0)
         self.bearing = bearing
         self.moving = bearing is not None and bearing.moves
-        self.w = w = max(self._rate_scale(), bearing.rate if self.moving else 0.0)
+        self.w = w = self._rate_scale()
+        if self.moving:
+            self.w = w = max(w, bearing.rate)
         self.horizon = HORIZON / w
         self.Om_scale = max(abs(self.Om0), w)
         if self.closed:

@@ -134,18 +134,24 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         self._set_inputs(float(Omega0), 0j, 1.0)  # the flight and wall models of the inputs
         self._bind_rotor()
 
+    _SPIN_STATE_CHOICES = (("step", "_spin_step"), ("_advance_free", "_spin_advance_free"),
+                           ("_advance_contact", "_spin_advance_contact"),
+                           ("_advance_spin", "_spin_advance_spin"),
+                           ("_roll_or_slide", "_spin_roll_or_slide"),
+                           ("_cone_sign", "_spin_cone_sign"))
+    """The choices bound in place of the held spin's when the spin is a state."""
+
     def _bind_rotor(self) -> None:
         """Bind the segment choices of the rotor's spin model: the held spin's are the
         class's own (FlightSteps, ContactSteps); with the spin a state (J finite) the
-        instance takes SpinSteps' in their place, for the same step loop."""
+        instance takes SpinSteps' in their place (``_SPIN_STATE_CHOICES``: its step entry
+        and segment choices), for the same step loop."""
         held = self._J == INF
-        for name in ("_advance_free", "_advance_contact", "_advance_spin", "_roll_or_slide",
-                     "_cone_sign"):
+        for name, spin in self._SPIN_STATE_CHOICES:
             if held:
                 self.__dict__.pop(name, None)
             else:
-                setattr(self, name, getattr(self, "_spin" + name))
-    # ------------------------------------------------------------------ constructors
+                setattr(self, name, getattr(self, spin))
 
     @classmethod
     def from_scaled(
@@ -358,8 +364,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         The step's work is bounded by ``budget`` work units (default and at most WORK_MAX).
         A step that would need more stops where it is with STATUS_WORK_CAP and a message
         saying where (docs/model.md 7)."""
-        if self._J != INF:
-            return self._spin_step(h, F_ext, amb_on, budget, T_drive)
+        if self._J != INF:  # (an instance with the spin a state has step bound to it)
+            return self._spin_step(h, Omega, F_ext, amb_on, budget, T_drive=T_drive)
         if T_drive or Omega is None:
             self._reject_held_spin_inputs(Omega, T_drive)
         F = complex(F_ext)

@@ -52,10 +52,12 @@ class SpinSteps:
 
     # ------------------------------------------------------------------ stepping
 
-    def _spin_step(self, h: float, F_ext: complex, amb_on: float, budget: int | None,
-                   T_drive: float) -> StepReport:
-        """Advance by h (s) with T_drive (N m), F_ext (N) and amb_on held; ``Omega`` is
-        ignored (the spin is a state). Work bound as TouchdownCore.step."""
+    def _spin_step(self, h: float, Omega: float | None = None, F_ext: complex = 0j,
+                   amb_on: float = 1.0, budget: int | None = None, *,
+                   T_drive: float = 0.0) -> StepReport:
+        """``step`` with the spin a state (bound in its place by ``_bind_rotor``): advance by
+        h (s) with T_drive (N m), F_ext (N) and amb_on held; ``Omega`` is ignored. Work bound
+        as TouchdownCore.step."""
         F = complex(F_ext)
         if not (0.0 < h < math.inf and math.isfinite(T_drive) and 0.0 <= amb_on <= 1.0
                 and math.isfinite(F.real) and math.isfinite(F.imag)):
