@@ -97,7 +97,7 @@ def instructions() -> dict[str, float]:
         script.write_text(BI.SPIN_CHILD)
         src = str(B.ROOT / "fmu_src")
         for kind in BI.SPIN_KINDS:
-            out[kind] = BI.per_unit(script, [src, kind], *BI.SPIN_STEPS)
+            out[kind] = BI.per_unit(script, [src, kind], *BI.SPIN_STEPS[kind])
             print(f"{kind:>18}: {out[kind] / 1e3:9.1f} k instructions per 1e-4 s step")
     return out
 
