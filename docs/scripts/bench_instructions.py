@@ -1,7 +1,7 @@
 """Deterministic cost figures: instructions counted by valgrind's callgrind.
 
     apt-get install valgrind && python docs/scripts/bench_instructions.py   # ~5 min
-    python docs/scripts/bench_instructions.py --base <commit>                # ~6 min
+    python docs/scripts/bench_instructions.py --base <commit>                # ~10 min
 
 Timed ratios on a shared machine scatter (docs/benchmarks.md). Instruction counts do not,
 so this script counts them for the ratios that sit near their goals:
@@ -25,19 +25,22 @@ seeds, dict layouts moved a 200-step run by 14M instructions; with a fixed one, 
 The child processes import only FMPy or the core, never numpy or this script's module, to
 keep that start-up small. Prints a table and writes docs/bench_instructions.json.
 
-``--base C`` counts the same figures, DOP853's left out, for commit C and for the current
-tree (with its uncommitted changes), one after the other in the same run, and judges each
-figure against "no worse than before within 2 %" (head <= base * 1.02). C is checked out
-in a temporary ``git worktree add --detach`` (fingerprint.py's add_worktree, removed at the
-end). Per tree: both FMUs are built into the temporary directory by that tree's own
+``--base C`` counts the same figures, DOP853's left out, and bench_spin.py's figures of the
+spin as a state (instructions per 1e-4 s step of ``SpinCore.step`` in closed-form flight,
+integrated flight, sliding and rolling: SPIN_CHILD, the difference of two runs of
+SPIN_STEPS after the same warm-up) for commit C and for the current tree (with its
+uncommitted changes), one after the other in the same run, and judges each count against
+"no worse than before within 2 %" (head <= base * 1.02). C is checked out in a temporary
+``git worktree add --detach`` (fingerprint.py's add_worktree, removed at the end). Per tree:
+both FMUs are built into the temporary directory by that tree's own
 ``benchmarks.build_fmus`` (its build.py, its floor FMU, its variables) in a child process,
 and every child runs with ``PYTHONPATH=<tree>/fmu_src`` (fingerprint.py's tree_env), the
-core child with ``<tree>/fmu_src`` first on sys.path, so the editable install does not
-win; a sanity check prints where each tree's core child and RotorTouchdown FMU imported
-``rotortd`` from, and stops unless it is that tree's fmu_src or the FMU's resources copied
-from it. The scenes are made once, here, from the current tree and handed to both. The
-children run with ``OPENBLAS_NUM_THREADS=1``: FMPy imports numpy, whose
-OpenBLAS worker threads spin for a time-dependent number of instructions (a 0-step FMU run
+core and spin children with ``<tree>/fmu_src`` first on sys.path, so the editable install
+does not win; a sanity check prints where each tree's core and spin children and
+RotorTouchdown FMU imported ``rotortd`` from, and stops unless it is that tree's fmu_src or
+the FMU's resources copied from it. The scenes are made once, here, from the current tree
+and handed to both. The children run with ``OPENBLAS_NUM_THREADS=1``: FMPy imports numpy,
+whose OpenBLAS worker threads spin for a time-dependent number of instructions (a 0-step FMU run
 scattered by 40M instructions, 10k per step in the 4000-step difference; single-threaded,
 by 5k instructions). Prints the table (figure, base, head, head/base - 1, verdict) and writes
 docs/bench_instructions_base.json with both commits' hashes; exit 1 if a figure is worse.
@@ -124,6 +127,44 @@ if sys.argv[-1] == "origin":
     print(sys.modules["rotortd"].__file__)
 '''
 
+SPIN_CHILD = '''
+import cmath, sys
+sys.path.insert(0, sys.argv[1])
+from rotortd import RotorParams, SpinCore
+kind, n = sys.argv[2], int(sys.argv[3])
+p = RotorParams(g=9.81)
+J, h = 0.5 * p.m * p.R ** 2, 1e-4
+if kind == "flight_closed":      # bearing off, no gravity, mass centre at rest at the
+    q = RotorParams(g=0.0)       # origin: the geometric centre circles at radius e_c < c_r
+    core = SpinCore(q, J=J, v0=-1j * 184.2 * q.e_c * cmath.exp(1j * q.phi), Omega0=184.2)
+    warm, ins = 100, {"amb_on": 0.0}
+elif kind == "flight_integrated":  # bearing on: the levitated whirl, Omega slowly braked
+    core = SpinCore.on_steady_whirl(p, 184.2, J=J)
+    warm, ins = 100, {"amb_on": 1.0}
+elif kind == "sliding":          # pressed down, the drive torque balancing the friction
+    core = SpinCore(p, J=J, Omega0=184.2)
+    warm, ins = 1000, {"amb_on": 0.0, "F_ext": -5000j, "T_drive": 0.04 * 0.15 * 5490.5}
+else:                            # rolling: dry whirl after the drop
+    core = SpinCore.on_steady_whirl(p, 184.2, J=J)
+    warm, ins = 1000, {"amb_on": 0.0}
+for _ in range(warm + n):
+    core.step(h, **ins)
+assert core.mode == {"flight_closed": 0, "flight_integrated": 0, "sliding": 1,
+                     "rolling": 2}[kind], (kind, core.mode)
+if sys.argv[-1] == "origin":
+    print(sys.modules["rotortd"].__file__)
+'''
+"""Instructions of ``SpinCore.step`` at 1e-4 s in one kind of segment (argv: fmu_src, kind,
+steps[, "origin"]); the kinds are SPIN_KINDS. Public names and keyword arguments only (all
+but ``params``), so the same text runs on e272741's flat core and on today's. Shared with
+bench_spin.py."""
+SPIN_KINDS = ("flight_closed", "flight_integrated", "sliding", "rolling")
+SPIN_STEPS = {"flight_closed": (20, 2020), "flight_integrated": (20, 220), "sliding": (20, 220),
+              "rolling": (20, 220)}
+"""Steps after the warm-up of the short and the long spin run (their difference is counted).
+Closed-form flight costs ~0.1M instructions a step, and a run of the child scatters by up to
+3M (callgrind, fixed hash seed; both trees): over 200 steps that is 15 %, over 2000, 1.5 %."""
+
 DOP_CHILD = '''
 import pickle, sys
 D = pickle.load(open(sys.argv[1], "rb"))
@@ -201,8 +242,9 @@ def core_tables(tmp: Path, scenes: dict[str, B.Scene], tree: Path = B.ROOT) -> P
 
 
 def write_children(tmp: Path) -> dict[str, Path]:
-    """The child scripts in tmp: fmu, core, dop, build."""
-    texts = {"fmu": FMU_CHILD, "core": CORE_CHILD, "dop": DOP_CHILD, "build": BUILD_CHILD}
+    """The child scripts in tmp: fmu, core, spin, dop, build."""
+    texts = {"fmu": FMU_CHILD, "core": CORE_CHILD, "spin": SPIN_CHILD, "dop": DOP_CHILD,
+             "build": BUILD_CHILD}
     paths = {k: tmp / f"{k}_child.py" for k in texts}
     for k, path in paths.items():
         path.write_text(texts[k])
@@ -232,6 +274,17 @@ def count_core(child: Path, pkl: Path, env: Env | None = None) -> dict[str, floa
             out[f"{scene} {mode}"] = per_s
             print(f"{scene:12s} core, {mode:>4s} calls: {per_s / 1e6:6.1f}M instructions "
                   "per simulated second", flush=True)
+    return out
+
+
+def count_spin(child: Path, src: Path, env: Env | None = None) -> dict[str, float]:
+    """Instructions per 1e-4 s step of ``SpinCore.step`` of the core in ``src`` (a tree's
+    fmu_src), per kind of segment (SPIN_CHILD)."""
+    out: dict[str, float] = {}
+    for kind in SPIN_KINDS:
+        out[kind] = per_unit(child, [str(src), kind], *SPIN_STEPS[kind], env=env)
+        print(f"{kind:>18s} spin state: {out[kind] / 1e3:9.1f}k instructions per 1e-4 s "
+              "step", flush=True)
     return out
 
 
@@ -305,27 +358,32 @@ def same_package(copy: Path, src: Path) -> bool:
 
 def check_origins(tree: Path, children: dict[str, Path], fmu_pkl: Path, core_pkl: Path,
                   env: Env) -> None:
-    """Stop unless the core child imports ``tree``'s rotortd and the FMU a copy of it."""
+    """Stop unless the core and spin children import ``tree``'s rotortd and the FMU a copy
+    of it."""
     src = tree / "fmu_src" / "rotortd"
     core = rotortd_origin(children["core"], [str(core_pkl), "limit_cycle", "seg"], env)
+    spin = rotortd_origin(children["spin"], [str(src.parent), "flight_closed"], env)
     fmu = rotortd_origin(children["fmu"], [str(fmu_pkl), "fmu", "free_whirl"], env)
-    print(f"rotortd of {tree}: core child {core}, FMU {fmu}", flush=True)
-    if core.resolve() != src.resolve():
-        raise SystemExit(f"the core child imported rotortd from {core}, not {src}")
+    print(f"rotortd of {tree}: core child {core}, spin child {spin}, FMU {fmu}", flush=True)
+    for name, origin in (("core", core), ("spin", spin)):
+        if origin.resolve() != src.resolve():
+            raise SystemExit(f"the {name} child imported rotortd from {origin}, not {src}")
     if not same_package(fmu, src):
         raise SystemExit(f"the FMU's rotortd ({fmu}) is not a copy of {src}")
 
 
 def count_in_tree(tree: Path, work: Path, scenes: dict[str, B.Scene]) -> dict[str, Any]:
-    """Every figure but DOP853's for ``tree``, its FMUs built and its children run in
-    ``work``."""
+    """Every figure but DOP853's for ``tree``, and its spin-state figures, its FMUs built
+    and its children run in ``work``."""
     work.mkdir(parents=True)
     children = write_children(work)
     env = {**FP.tree_env(tree), **SINGLE_THREAD}
     fmu_pkl = fmu_tables(work, scenes, tree_fmus(tree, work, children["build"]))
     core_pkl = core_tables(work, scenes, tree)
     check_origins(tree, children, fmu_pkl, core_pkl, env)
-    return count_tree(children, fmu_pkl, core_pkl, env)
+    out = count_tree(children, fmu_pkl, core_pkl, env)
+    out["spin_per_step"] = count_spin(children["spin"], tree / "fmu_src", env)
+    return out
 
 
 def git(*args: str) -> str:
@@ -340,6 +398,7 @@ def figures(res: dict[str, Any]) -> dict[str, float]:
         out.update({f"FMU step {scene} {k}": d[k] for k in ("fmu", "floor", "ratio")})
     out.update({f"core/s {k}": v for k, v in res["core_per_second"].items()})
     out["core chattering/limit_cycle 1e-3"] = res["chattering_vs_limit_cycle_core_1e-3"]
+    out.update({f"spin step {k}": v for k, v in res["spin_per_step"].items()})
     return out
 
 
@@ -352,15 +411,15 @@ def compare(base: dict[str, Any], head: dict[str, Any]) -> dict[str, dict[str, A
 
 
 def is_count(name: str) -> bool:
-    """A figure the criterion judges: an instruction count per FMU step or per simulated
-    second. The ratios (to the floor, chattering to limit cycle) are shown, not judged: a
-    ratio also moves when its denominator gets cheaper."""
-    return name.endswith(("fmu", "floor")) or name.startswith("core/s")
+    """A figure the criterion judges: an instruction count per FMU step, per simulated
+    second or per spin-state step. The ratios (to the floor, chattering to limit cycle) are
+    shown, not judged: a ratio also moves when its denominator gets cheaper."""
+    return name.endswith(("fmu", "floor")) or name.startswith(("core/s", "spin step"))
 
 
 def fmt(name: str, value: float) -> str:
     """A figure for the table: per-step counts in k, per-second counts in M."""
-    if name.endswith(("fmu", "floor")):
+    if name.endswith(("fmu", "floor")) or name.startswith("spin step"):
         return f"{value / 1e3:.1f}k"
     if name.startswith("core/s"):
         return f"{value / 1e6:.2f}M"

@@ -15,7 +15,9 @@
    inside the clearance), free flight integrated (bearing on, the levitated whirl), sliding
    (pressed to the wall by F_ext with a drive torque balancing the friction) and rolling
    (dry whirl, after the drop), each as the difference of two runs of different length
-   after the same warm-up, so start-up and warm-up cancel.
+   after the same warm-up, so start-up and warm-up cancel. The child is
+   bench_instructions.py's SPIN_CHILD, which ``bench_instructions.py --base`` also counts
+   on both trees.
 Writes docs/bench_spin.json; docs/benchmarks.md quotes it.
 """
 
@@ -35,7 +37,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-import bench_instructions as BI  # noqa: E402 (docs/scripts: callgrind helpers)
+import bench_instructions as BI  # noqa: E402 (docs/scripts: callgrind, SPIN_CHILD)
 import benchmarks as B  # noqa: E402 (docs/scripts: the FMU builds and the floor FMU)
 from rotortd import RotorParams, TouchdownCore  # noqa: E402
 
@@ -43,32 +45,6 @@ OUT = B.ROOT / "docs" / "bench_spin.json"
 H, T_END, OMEGA0 = 1e-4, 0.3, 184.2
 P = RotorParams(g=9.81)
 J_HALF = 0.5 * P.m * P.R ** 2
-
-CORE_CHILD = '''
-import cmath, sys
-sys.path.insert(0, sys.argv[1])
-from rotortd import RotorParams, SpinCore, TouchdownCore
-kind, n = sys.argv[2], int(sys.argv[3])
-p = RotorParams(g=9.81)
-J, h = 0.5 * p.m * p.R ** 2, 1e-4
-if kind == "flight_closed":      # bearing off, no gravity, mass centre at rest at the
-    q = RotorParams(g=0.0)       # origin: the geometric centre circles at radius e_c < c_r
-    core = SpinCore(q, J, v0=-1j * 184.2 * q.e_c * cmath.exp(1j * q.phi), Omega0=184.2)
-    warm, ins = 100, {"amb_on": 0.0}
-elif kind == "flight_integrated":  # bearing on: the levitated whirl, Omega slowly braked
-    core = SpinCore.on_steady_whirl(p, 184.2, J=J)
-    warm, ins = 100, {"amb_on": 1.0}
-elif kind == "sliding":          # pressed down, the drive torque balancing the friction
-    core = SpinCore(p, J, Omega0=184.2)
-    warm, ins = 1000, {"amb_on": 0.0, "F_ext": -5000j, "T_drive": 0.04 * 0.15 * 5490.5}
-else:                            # rolling: dry whirl after the drop
-    core = SpinCore.on_steady_whirl(p, 184.2, J=J)
-    warm, ins = 1000, {"amb_on": 0.0}
-for _ in range(warm + n):
-    core.step(h, **ins)
-assert core.mode == {"flight_closed": 0, "flight_integrated": 0, "sliding": 1,
-                     "rolling": 2}[kind], (kind, core.mode)
-'''
 
 
 def drop_start_values() -> dict[str, Any]:
@@ -118,10 +94,10 @@ def instructions() -> dict[str, float]:
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         script = Path(tmp) / "child.py"
-        script.write_text(CORE_CHILD)
+        script.write_text(BI.SPIN_CHILD)
         src = str(B.ROOT / "fmu_src")
-        for kind in ("flight_closed", "flight_integrated", "sliding", "rolling"):
-            out[kind] = BI.per_unit(script, [src, kind], 20, 220)
+        for kind in BI.SPIN_KINDS:
+            out[kind] = BI.per_unit(script, [src, kind], *BI.SPIN_STEPS[kind])
             print(f"{kind:>18}: {out[kind] / 1e3:9.1f} k instructions per 1e-4 s step")
     return out
 
