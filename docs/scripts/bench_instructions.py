@@ -351,9 +351,11 @@ def rotortd_origin(child: Path, args: list[str], env: Env) -> Path:
 
 
 def same_package(copy: Path, src: Path) -> bool:
-    """Every .py of package ``src`` is in ``copy`` with the same bytes."""
-    return all((copy / f.name).exists() and (copy / f.name).read_bytes() == f.read_bytes()
-               for f in src.glob("*.py"))
+    """Every .py of package ``src``, in its subfolders too, is in ``copy`` with the same
+    bytes."""
+    return all((copy / f.relative_to(src)).exists()
+               and (copy / f.relative_to(src)).read_bytes() == f.read_bytes()
+               for f in src.rglob("*.py") if "__pycache__" not in f.parts)
 
 
 def check_origins(tree: Path, children: dict[str, Path], fmu_pkl: Path, core_pkl: Path,
