@@ -3,6 +3,7 @@
     python docs/scripts/mutants.py --list               # the table, and where each change applies
     python docs/scripts/mutants.py --only E1,S1         # run two mutants
     python docs/scripts/mutants.py [--jobs 1] [--timeout 1800] [--json docs/mutants.json]
+    python docs/scripts/mutants.py --docs               # the table of docs/mutants.md from the json
 
 Each mutant is one physically meaningful change of the sources, located by an exact snippet
 (``old`` -> ``new``), never by file or line: the snippet must occur exactly once in all of
@@ -353,6 +354,31 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def summary(doc: dict[str, Any]) -> str:
+    """One line: the counts of each result and the run's time."""
+    rows = doc.get("mutants", [])
+    counts = {k: sum(r.get("status") == k for r in rows)
+              for k in ("killed", "survived", "stale", "timeout", "error")}
+    equiv = sum(r.get("status") == "survived" and bool(r.get("equivalent")) for r in rows)
+    parts = [f"{n} {k}" for k, n in counts.items() if n]
+    line = f"{len(rows)} mutants: {', '.join(parts)}"
+    if counts["survived"]:
+        line += f" ({equiv} of the survivors shown equivalent)"
+    if "full_run_seconds" in doc:
+        line += (f". Full run: {doc['full_run_seconds'] / 60:.0f} min wall time with "
+                 f"--jobs {doc.get('jobs', 1)}")
+    return line + "."
+
+
+def write_docs(json_path: Path, page: Path) -> None:
+    """Put the table of ``json_path`` into the ``mutants`` block of ``page``."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from mdblock import replace_block
+
+    doc = json.loads(json_path.read_text(encoding="utf-8"))
+    replace_block(page, "mutants", summary(doc) + "\n\n" + table(doc.get("mutants", [])))
+
+
 def list_table(mutants: tuple[Mutant, ...]) -> str:
     """Each mutant and where its snippet applies in the working tree (no run)."""
     lines = []
@@ -373,7 +399,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="seconds for one mutant's quick group (default 1800)")
     ap.add_argument("--json", type=Path, default=DEFAULT_JSON, help="where to write results")
     ap.add_argument("--keep", action="store_true", help="keep the temporary copies")
+    ap.add_argument("--docs", action="store_true",
+                    help="only rewrite the table of docs/mutants.md from the json")
     args = ap.parse_args(argv)
+    if args.docs:
+        write_docs(args.json, ROOT / "docs" / "mutants.md")
+        return 0
     mutants = MUTANTS
     if args.only:
         wanted = [s.strip() for s in args.only.split(",") if s.strip()]
