@@ -241,3 +241,51 @@ def test_spin_state_contact_segments_at_their_documented_accuracy() -> None:
             worst[key] = max(worst.get(key, 0.0), err[key] / bound)
             assert err[key] <= bound, (name, key, err[key], bound)
     assert max(worst.values()) > 0.5  # the figures are measured ones, not loose bounds
+
+
+_BOUNDS_SCRIPT = r"""
+import json, os, sys
+sys.path.insert(0, sys.argv[2])
+from fmpy import extract
+from fmu_scenarios import MESSAGES, Instance
+unzip = extract(sys.argv[1])
+rows = []
+for name, value, start, mid_run in json.loads(sys.argv[3]):
+    MESSAGES.clear()
+    inst = Instance(sys.argv[1], unzipdir=unzip)
+    inst.init(start)
+    if mid_run:
+        inst.set({name: value})
+    inst.step(1e-6)
+    rows.append([name, value, [m["message"] for m in MESSAGES if m["status"] >= 3]])
+    inst.free()
+print("RESULT:" + json.dumps(rows), flush=True)
+sys.stderr.flush()
+os._exit(0)
+"""
+
+
+def test_every_declared_bound_is_accepted(fmu_path: Path) -> None:
+    """docs/fmu.md "Ranges": "Every Real parameter and input has a finite, inclusive range,
+    declared as min/max ... and enforced by the FMU with the same numbers"; "FMI min/max are
+    inclusive and are exactly what the FMU accepts". Each parameter at its min and at its max
+    at initialisation (x0, y0 with c_r = 0.1 m, so that the start lies in the clearance), each
+    input at its min and max mid-run: no range error (a step at such values may still stop at
+    the work bound, which is not a range error)."""
+    inputs = ("Omega", "F_x", "F_y", "amb_on", "T_drive")
+    cases = []
+    for name, lim in LIMITS.items():
+        for value in (lim.lo, lim.hi):
+            start = {"c_r": 0.1} if name in ("x0", "y0") else {}
+            if name not in inputs:
+                start[name] = value
+            cases.append((name, value, start, name in inputs))
+    proc = subprocess.run([sys.executable, "-c", _BOUNDS_SCRIPT, str(fmu_path), str(HERE),
+                           json.dumps(cases)], capture_output=True, text=True, timeout=300)
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT:")]
+    assert lines, proc.stderr[-3000:]
+    rows = json.loads(lines[-1][len("RESULT:"):])
+    assert len(rows) == 2 * len(LIMITS)
+    refused = [(name, value, msgs) for name, value, msgs in rows
+               if any("out of range" in m or "not finite" in m for m in msgs)]
+    assert not refused, refused
