@@ -115,6 +115,32 @@ def test_impacts_of_random_flights_polished_to_their_conditioning() -> None:
     assert found >= 80, found
 
 
+@pytest.mark.parametrize("rising", [True, False])
+@pytest.mark.parametrize("whirl", [1.0, -1.0])
+def test_touch_at_zero_normal_force_is_decided_by_its_rate(rising: bool, whirl: float) -> None:
+    """docs/model.md §3: at the wall with zero normal speed, "A contact with zero normal speed
+    is never an impact"; "When g'' is itself at rounding level, the sign of the exact g'''
+    decides, with the same tie-break as lift-off". A start on the wall moving tangentially,
+    with the contact-free normal force exactly balanced (Gn = 0: g' = g'' = 0 to rounding)
+    and a constant force that makes Gn rise (g''' > 0) or fall: rising, contact begins at
+    once (sliding at t = 0); falling, the rotor flies off the wall; never an impact."""
+    p = BASE.replace(e_c=0.0)
+    kappa, th = p.k / p.m, 0.3
+    turn = 1.0 if rising == (whirl > 0) else -1.0  # d Gn/dt = theta' Im(q0 e^{-i theta})
+    q0 = (0.5 + 0.3j * turn) * kappa * cmath.exp(1j * th)  # per unit m c_r (1/s^2)
+    dth = whirl * math.sqrt(kappa - (q0 * cmath.exp(-1j * th)).real)  # Gn = 0
+    e = cmath.exp(1j * th)
+    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+    F = q0 * p.m * p.c_r - p.gravity_force - p.bias_force  # F_ext giving q0 with amb_on = 1
+    rep = core.step(1e-4, 0.0, F, 1.0)
+    assert rep.status == 0, rep.message
+    assert rep.impacts == []
+    if rising:
+        assert rep.transitions[:1] == [(0.0, "sliding")] and core.mode != MODE_FREE
+    else:
+        assert core.mode == MODE_FREE and abs(core.z) < p.c_r
+
+
 # ------------------------------------------------------------------ lift-off
 def _whirl_on_the_wall() -> tuple[TouchdownCore, float]:
     """The scene of test_lift_off_time_matches_high_precision_sliding: whirling on the wall
