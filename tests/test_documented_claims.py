@@ -132,13 +132,19 @@ def test_touch_at_zero_normal_force_is_decided_by_its_rate(rising: bool, whirl: 
     e = cmath.exp(1j * th)
     core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
     F = q0 * p.m * p.c_r - p.gravity_force - p.bias_force  # F_ext giving q0 with amb_on = 1
-    rep = core.step(1e-4, 0.0, F, 1.0)
-    assert rep.status == 0, rep.message
-    assert rep.impacts == []
+    h = 1e-16 if rising else 1e-4  # rising: N stays within its rounding band 2 steps
+    reps = [core.step(h, 0.0, F, 1.0)]
+    assert reps[0].status == 0, reps[0].message
     if rising:
-        assert rep.transitions[:1] == [(0.0, "sliding")] and core.mode != MODE_FREE
+        assert reps[0].transitions == [(0.0, "sliding")] and core.mode != MODE_FREE
+        # §5 "Boundaries in rounding": at N = 0 "contact persists if dN/dt > 0", decided
+        # "with the same rule on both sides of the switch, so a state is never handed back
+        # and forth": the next steps start at N = 0 to rounding and stay in contact
+        reps += [core.step(hh, 0.0, F, 1.0) for hh in (1e-16, 1e-4)]
+        assert [r.transitions for r in reps[1:]] == [[], []] and core.mode != MODE_FREE
     else:
         assert core.mode == MODE_FREE and abs(core.z) < p.c_r
+    assert all(r.impacts == [] for r in reps)
 
 
 # ------------------------------------------------------------------ lift-off
