@@ -181,6 +181,86 @@ def test_sliding_leaves_the_wall_when_n_reaches_zero(past: float) -> None:
     assert len(lifts) == 1 and abs(lifts[0] - t_lift) * wn <= 1e-12, (lifts, t_lift)
 
 
+def _rolling_margin(p: RotorParams, F: complex, W: float, th0: float, dth: float, t: float
+                    ) -> tuple[float, float]:
+    """(min(Gn, mu Gn - |Gt|), scale) at time t of rolling from theta0 at theta' = dth with
+    psi0 = 0, written out from docs/model.md §5 (per unit m c_r, 1/s^2):
+    Gn = Re(Q e^{-i theta}) - kappa + theta'^2, Gt = Im(Q e^{-i theta}) - beta theta',
+    Q = (a F_bias - i m g + F_ext)/(m c_r) + e_c Omega^2 e^{i(psi + phi)}/c_r, a = 1."""
+    q0 = (p.bias_force + p.gravity_force + F) / (p.m * p.c_r)
+    eu = p.e_c * W * W * cmath.exp(1j * p.phi) / p.c_r
+    P = (q0 + eu * cmath.exp(1j * W * t)) * cmath.exp(-1j * (th0 + dth * t))
+    gn = P.real - p.k / p.m + dth * dth
+    gt = P.imag - p.c / p.m * dth
+    scale = abs(q0) + abs(eu) + p.k / p.m + dth * dth + p.c / p.m * abs(dth)
+    return min(gn, p.mu * gn - abs(gt)), scale
+
+
+def test_rolling_exits_are_never_stepped_over() -> None:
+    """docs/model.md §5 "Transitions": rolling -> sliding when |Gt| reaches mu Gn, and
+    lift-off when Gn reaches 0, located by "conservative advancement on the trig sums, with
+    |f''| <= sum |a_j| nu_j^2 (rigorous, like §3)". On 150 random rolling starts (a touch
+    with zero slip, pressed, inside the cone), the first exit of each lies where the exit
+    function, computed here from the model's equations, is 0 to 1e-12 of its scale, and it
+    is positive at 400 points per radian before: no exit stepped over, none located late."""
+    import random
+
+    checked = 0
+    for seed in range(150):
+        rng = random.Random(seed)
+        p = BASE.replace(e_c=rng.choice([0.0, 0.3e-3]), mu=rng.uniform(0.05, 0.5),
+                         c=rng.uniform(0.0, 5000.0))
+        W = rng.uniform(1.0, 60.0)
+        dth = -p.R * W / p.c_r  # rolling: v_rel = R Omega + c_r theta' = 0
+        th0 = rng.uniform(-3.0, 3.0)
+        q = rng.uniform(0.2, 3.0) * abs(dth * dth - p.k / p.m) * cmath.exp(
+            1j * rng.uniform(-3.0, 3.0))
+        F = q * p.m * p.c_r
+        e = cmath.exp(1j * th0)
+        core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+        rep = core.step(3e-3, W, F, 1.0)
+        tr = rep.transitions
+        if len(tr) < 2 or tr[0] != (0.0, "rolling"):
+            continue
+        t1 = tr[1][0]
+        f1, scale = _rolling_margin(p, F, W, th0, dth, t1)
+        assert abs(f1) <= 1e-12 * scale, (seed, tr[:2], f1 / scale)
+        n = max(8, int(400 * t1 * max(abs(dth), abs(W - dth))))
+        early = [_rolling_margin(p, F, W, th0, dth, t1 * j / n)[0] for j in range(n)]
+        assert min(early) > -1e-12 * scale, (seed, tr[:2], min(early) / scale)
+        checked += 1
+    assert checked >= 10, checked
+
+
+@pytest.mark.parametrize("W, frac", [(300.0, 0.5), (200.0, 0.3), (250.0, 0.9)])
+def test_rolling_with_two_phasors_ends_where_they_align(W: float, frac: float) -> None:
+    """docs/model.md §5: rolling provably never ends only when "C - |a1| - |a2| > 0"; here
+    C - |a1| = frac |a2| > 0 but the two phasors of Gn (the constant force's, rotating at
+    -theta', and the imbalance's, at Omega - theta') align one whirl turn later, where Gn
+    (computed here from the model's equations) is negative. Rolling must end before (the
+    first exit where its function is 0 to 1e-12 of its scale, positive before): the wall
+    never pulls. A clearance as large as the radius makes the two rates differ (1.5 : 1)."""
+    p = BASE.replace(e_c=0.002, mu=10.0, R=0.02, c_r=0.01)
+    th0 = 0.7
+    dth = -p.R * W / p.c_r
+    C = dth * dth - p.k / p.m
+    eu = p.e_c * W * W / p.c_r
+    u_align = 2.0 * math.pi / -dth
+    p = p.replace(phi=math.pi - (W - dth) * u_align + th0)  # both phasors at -1 at u_align
+    F = -(C - frac * eu) * cmath.exp(1j * th0) * p.m * p.c_r
+    assert _rolling_margin(p, F, W, th0, dth, u_align)[0] < 0.0
+    e = cmath.exp(1j * th0)
+    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+    rep = core.step(u_align, W, F, 1.0)
+    assert rep.status == 0, rep.message
+    assert rep.transitions[0] == (0.0, "rolling") and len(rep.transitions) >= 2, rep.transitions
+    t1 = rep.transitions[1][0]
+    f1, scale = _rolling_margin(p, F, W, th0, dth, t1)
+    assert abs(f1) <= 1e-12 * scale, f1 / scale
+    n = int(400 * t1 * (W - dth))
+    assert min(_rolling_margin(p, F, W, th0, dth, t1 * j / n)[0] for j in range(n)) > 0.0
+
+
 # ------------------------------------------------------------------ F_n_peak
 def test_f_n_peak_is_the_largest_impact_not_their_sum() -> None:
     """docs/fmu.md: F_n_peak is the "Peak normal contact force within the step"; StepReport:
