@@ -1,18 +1,23 @@
 """Documented claims pinned at the level the docs state them (issue 27).
 
-Each test names the doc line it pins. They were written against single changes of the core
-that the rest of the quick group let pass (docs/mutants.md lists them):
+Each test quotes the doc line it pins. They were written against single changes of the core
+that the rest of the quick group let pass (docs/scripts/mutants.py, docs/mutants.md):
 
 - event location (docs/model.md §3 "Resolution and classification"; §8 "contact search in
   flight"): a crossing resolvable by the search is found, its impact lies on the circle to
   1 ulp and its time within a small multiple (8, as in tests/test_core_events.py) of
-  eps (c_r/rdot + t), against the exact time of a vertical toss (closed form, 50 digits);
-- the lift-off condition (docs/model.md §5 "Transitions": lift-off when `Gn` reaches 0):
-  a step that ends just past the lift-off has lifted off there, the wall never pulls;
+  eps (c_r/rdot + t), against the exact time of a vertical toss (closed form, 50 digits) and
+  on random flights against mpmath; a touch at N = 0 is decided by the rate of N, never an
+  impact, and never handed back and forth (§3, §5 "Boundaries in rounding");
+- the lift-off condition (§5 "Transitions": lift-off when `Gn` reaches 0): a step that
+  ends just past the lift-off has lifted off there, the wall never pulls; rolling exits are
+  located where the exit function is 0, never stepped over, also with two phasors;
 - the misuse table of docs/fmu.md, row "tunable set out of range mid-run": for every
-  tunable, not only `d` (whose declared range is also the core's own domain);
+  tunable, not only `d` (whose declared range is also the core's own domain); and every
+  declared bound is accepted (docs/fmu.md "Ranges": inclusive);
 - `F_n_peak` (docs/fmu.md variables table, "Peak normal contact force within the step";
-  StepReport): the largest impact's P_n/h, not their sum.
+  StepReport): the largest impact's P_n/h, not their sum;
+- the spin-state contact segments at the accuracy docs/model.md §8 states.
 """
 
 from __future__ import annotations
