@@ -23,6 +23,7 @@ that the rest of the quick group let pass (docs/scripts/mutants.py, docs/mutants
 from __future__ import annotations
 
 import cmath
+import itertools
 import json
 import math
 import subprocess
@@ -264,6 +265,60 @@ def test_rolling_with_two_phasors_ends_where_they_align(W: float, frac: float) -
     assert abs(f1) <= 1e-12 * scale, f1 / scale
     n = int(400 * t1 * (W - dth))
     assert min(_rolling_margin(p, F, W, th0, dth, t1 * j / n)[0] for j in range(n)) > 0.0
+
+
+def test_no_mode_is_entered_and_left_at_one_instant() -> None:
+    """docs/model.md §5 "Transitions": at zero slip, "sliding -> rolling" only when
+    |Gt| <= mu Gn, else "sliding -> sliding (slip reversal)"; "Boundaries in rounding": the
+    rule is the same on both sides of a switch, "so a state is never handed back and forth
+    at one instant". On 60 random contact starts (a tangential touch, pressed), over three
+    steps of 3 ms with slip reversals, rolling entries and lift-offs, no two reported mode
+    changes share an instant (a rolling entered and left at once would be one)."""
+    import random
+
+    seen = 0
+    for seed in range(60):
+        rng = random.Random(seed)
+        p = BASE.replace(e_c=rng.choice([0.0, 0.3e-3]), mu=rng.uniform(0.05, 0.5),
+                         c=rng.uniform(0.0, 5000.0))
+        W = rng.uniform(1.0, 60.0)
+        dth = -p.R * W / p.c_r * rng.uniform(0.5, 1.5)
+        th0 = rng.uniform(-3.0, 3.0)
+        q = rng.uniform(0.2, 3.0) * abs(dth * dth - p.k / p.m) * cmath.exp(
+            1j * rng.uniform(-3.0, 3.0))
+        e = cmath.exp(1j * th0)
+        core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+        tr: list[tuple[float, str]] = []
+        for _ in range(3):
+            rep = core.step(3e-3, W, q * p.m * p.c_r, 1.0)
+            assert rep.status == 0, rep.message
+            tr += rep.transitions
+        same = [(a, b) for a, b in itertools.pairwise(tr) if a[0] == b[0]]
+        assert not same, (seed, same)
+        seen += len(tr)
+    assert seen >= 100, seen
+
+
+def test_work_bound_and_segment_weight_are_the_documented_ones() -> None:
+    """docs/model.md §7: "WORK_MAX = 1,600,000 units per communication step ...
+    StepReport.work_cap reports it"; the weights: "a closed-form step ... 1-3", "a segment
+    of the step's event loop ... (SEGMENT_WORK) 8" on top; §5: in dry whirl "a rolling step
+    costs one closed-form evaluation". So a rolling step (the segment of the step loop,
+    rolling proved endless) reports 8 + 1 units."""
+    import rotortd
+
+    assert rotortd.WORK_MAX == 1_600_000
+    p = BASE.replace(e_c=0.0)
+    W, th0 = 60.0, 0.4
+    dth = -p.R * W / p.c_r
+    e = cmath.exp(1j * th0)
+    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+    first = core.step(1e-3, W)
+    assert first.transitions[-1][1] == "rolling", first.transitions
+    for _ in range(3):
+        rep = core.step(1e-3, W)
+        assert rep.work_cap == 1_600_000
+        assert rep.transitions == [] and rep.work == 8 + 1, (rep.transitions, rep.work)
 
 
 # ------------------------------------------------------------------ F_n_peak

@@ -138,7 +138,7 @@ MUTANTS: tuple[Mutant, ...] = (
     M("C2", "contact transitions", "slip zero always rolls (friction cone not checked)",
       "            self._dtheta = -wf.wr\n            self._choose_contact_mode()\n",
       "            self._dtheta = -wf.wr\n            self._mode = MODE_ROLLING\n",
-      ("tests/test_contact.py",)),
+      (CLAIMS,)),
     M("RO1", "contact modes", "rolling exit search: curvature bound M quartered (a step "
       "may jump over a lift-off or cone exit)",
       "M = abs(self.a1) * self.nu1**2 + abs(self.a2) * self.nu2**2",
@@ -191,12 +191,12 @@ MUTANTS: tuple[Mutant, ...] = (
       "rep.F_n_peak = rep.F_n_peak + imp.P_n * inv", (CLAIMS,)),
     # ---------------------------------------------------------------- work bound
     M("W1", "work bound", "WORK_MAX tenfold", "WORK_MAX = 1_600_000", "WORK_MAX = 16_000_000",
-      ("tests/test_work_bound.py",)),
+      (CLAIMS,)),
     M("W2", "work bound", "the step loop's work check ten times late",
       "                if work.total > cap:\n", "                if work.total > 10 * cap:\n",
       ("tests/test_work_bound.py",)),
     M("W3", "work bound", "a segment of the event loop costs 1 unit instead of 8",
-      "SEGMENT_WORK = 8", "SEGMENT_WORK = 1", ("tests/test_work_bound.py",)),
+      "SEGMENT_WORK = 8", "SEGMENT_WORK = 1", (CLAIMS,)),
     # ---------------------------------------------------------------- adapter
     M("A1", "adapter validation", "range check of tunables changed mid-run removed "
       "(issue 27)", "            self._require_ranges(tuple(changes))\n", "",
