@@ -321,6 +321,27 @@ def test_work_bound_and_segment_weight_are_the_documented_ones() -> None:
         assert rep.transitions == [] and rep.work == 8 + 1, (rep.transitions, rep.work)
 
 
+def test_the_impact_that_starts_contact_is_plastic() -> None:
+    """docs/model.md §6: when the low-speed rule fires, "The impact is made plastic (d = 0
+    for it, friction as usual) and sustained contact begins". Chattering from rest
+    (gamma = 0.3, d = 0.95): the impact at which sliding begins has P_n = m rdot (not
+    m (1 + d) rdot) and leaves no normal speed."""
+    from rotortd_tools.cycles import OMEGA, chapter_params, si_params
+
+    p = si_params(chapter_params(gamma=0.3))
+    assert p.d == 0.95
+    core = TouchdownCore(p, 0j, 0j)
+    while core.mode == MODE_FREE:
+        rep = core.step(1e-3, OMEGA)
+        assert rep.status == 0, rep.message
+    imp = rep.impacts[-1]
+    assert rep.transitions == [(rep.transitions[0][0], "sliding")]
+    assert abs(imp.t - rep.transitions[0][0]) <= 4 * EPS * imp.t
+    assert imp.P_n == pytest.approx(p.m * imp.rdot, rel=4 * EPS)
+    n = imp.z / abs(imp.z)
+    assert abs((n.conjugate() * imp.v_plus).real) <= 4 * EPS * abs(imp.v_plus)
+
+
 # ------------------------------------------------------------------ F_n_peak
 def test_f_n_peak_is_the_largest_impact_not_their_sum() -> None:
     """docs/fmu.md: F_n_peak is the "Peak normal contact force within the step"; StepReport:

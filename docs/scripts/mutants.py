@@ -161,7 +161,7 @@ MUTANTS: tuple[Mutant, ...] = (
       "N_CASCADE = 1000", "N_CASCADE = 100", ("tests/test_contact.py",)),
     M("L3", "low-speed rule", "the impact that starts contact keeps its restitution",
       "r = reset(n, v_minus, p.m, 0.0, p.mu, p.R, W)",
-      "r = reset(n, v_minus, p.m, p.d, p.mu, p.R, W)", ("tests/test_contact.py",)),
+      "r = reset(n, v_minus, p.m, p.d, p.mu, p.R, W)", (CLAIMS,)),
     M("L4", "low-speed rule", "accumulation time of the cascade halved (t_contact_entry)",
       "self._t_contact = t + (2.0 * d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)",
       "self._t_contact = t + (d * r.rdot / ((1.0 - d) * A) if d < 1.0 else 0.0)",
