@@ -63,6 +63,9 @@ class Mutant:
     new: str
     hint: tuple[str, ...] = ()
     equivalent: str = ""
+    note: str = ""
+    """For a survivor neither killed nor shown equivalent yet: what is known (shown in the
+    table)."""
 
 
 M = Mutant
@@ -153,7 +156,11 @@ MUTANTS: tuple[Mutant, ...] = (
       "LOCK_TOL = 1e-14", "LOCK_TOL = 1e-10", ("tests/test_contact.py",)),
     M("SC1", "spin-state contact", "spin-state contact: the midpoint check of the event "
       "functions dropped", "        if self._margin(mid) <= 0.0:\n",
-      "        if False:\n", ("tests/test_spin_contact_mp.py",)),
+      "        if False:\n", ("tests/test_spin_contact_mp.py",),
+      note="OPEN, not killed and not shown equivalent: the check only matters for an "
+      "event function that dips below 0 and back within one integrator step (at most 1 "
+      "rad) around its midpoint; 2,700 random spin-state contact segments (300 built to "
+      "graze N = 0) gave the same events and durations to the bit with and without it"),
     # ---------------------------------------------------------------- low-speed rule
     M("L1", "low-speed rule", "chattering threshold ETA_HEIGHT tenfold",
       "ETA_HEIGHT = 1e-14", "ETA_HEIGHT = 1e-13", ("tests/test_contact.py",)),
@@ -226,6 +233,9 @@ MUTANTS: tuple[Mutant, ...] = (
       '("clock.t_lo", "t_lo", FLOAT),', '("clock.t_lo", "t_lo", Codec(lambda x: 0.0, float)),',
       ("tests/test_core_state.py",)),
 )
+
+
+NOTES = {m.id: m.note for m in MUTANTS if m.note}
 
 
 # ---------------------------------------------------------------------------- the copy
@@ -345,8 +355,11 @@ def table(rows: list[dict[str, Any]]) -> str:
     lines = ["| id | area | change | result | killing test | s |", "|---|---|---|---|---|---|"]
     for r in rows:
         result = r.get("status", "not run")
+        note = NOTES.get(r["id"], "")
         if result == "survived" and r.get("equivalent"):
             result = f"survived, equivalent: {r['equivalent']}"
+        elif result == "survived" and note:
+            result = f"survived; {note}"
         elif result == "stale":
             result = f"stale ({r.get('detail', '')})"
         lines.append(f"| {r['id']} | {r['area']} | {r['change']} | {result} | "
