@@ -18,6 +18,11 @@
    after the same warm-up, so start-up and warm-up cancel. The child is
    bench_instructions.py's SPIN_CHILD, which ``bench_instructions.py --base`` also counts
    on both trees.
+3. Instructions (callgrind) per 1e-4 s FMU step of the quiet step with the spin as a state
+   (integrate_spin, the levitated whirl, bearing on), RotorTouchdown against the floor FMU
+   in the same FMU2Slave loop (every output read every step), with the inputs held and
+   with T_drive set before every step by a PI drive on Omega_out (QUIET_PI); the issue's
+   goal is a ratio of at most 1.5 (``--quiet-only`` counts only these).
 Writes docs/bench_spin.json; docs/benchmarks.md quotes it.
 """
 
@@ -25,6 +30,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import pickle
 import statistics
 import sys
 import tempfile
@@ -45,6 +52,80 @@ OUT = B.ROOT / "docs" / "bench_spin.json"
 H, T_END, OMEGA0 = 1e-4, 0.3, 184.2
 P = RotorParams(g=9.81)
 J_HALF = 0.5 * P.m * P.R ** 2
+
+FMU_CHILD = '''
+import pickle, sys
+from fmpy.fmi2 import FMU2Slave
+D = pickle.load(open(sys.argv[1], "rb"))
+f, pi, n = D[sys.argv[2]], sys.argv[3] == "pi", int(sys.argv[4])
+vr, h = f["vr"], D["h"]
+fmu = FMU2Slave(guid=f["guid"], unzipDirectory=f["unzip"], modelIdentifier=f["mid"],
+                instanceName="count")
+fmu.instantiate()
+for name, val in D["start"].items():
+    if isinstance(val, bool):
+        fmu.setBoolean([vr[name]], [val])
+    else:
+        fmu.setReal([vr[name]], [float(val)])
+fmu.setupExperiment(startTime=0.0)
+fmu.enterInitializationMode()
+fmu.exitInitializationMode()
+rv, iv, bv = ([vr[x] for x in names] for names in D["outputs"])
+kT, iW = [vr["T_drive"]], len(rv) - 1  # Omega_out is read last
+W_ref, kp, ki = D["pi"]
+W, integral = D["start"]["Omega"], 0.0
+for j in range(n):
+    if pi:  # a PI drive: T_drive from the speed error, set before every step
+        e = W_ref - W
+        integral += e * h
+        fmu.setReal(kT, [kp * e + ki * integral])
+    fmu.doStep(j * h, h)
+    W = fmu.getReal(rv)[iW]
+    fmu.getInteger(iv)
+    fmu.getBoolean(bv)
+fmu.terminate()
+fmu.freeInstance()
+'''
+QUIET_PI = (OMEGA0 + 1.0, 0.05, 2.0)
+"""The PI drive of the quiet spin-state count: (W_ref rad/s, k_p N m s, k_i N m)."""
+
+
+def quiet_start_values() -> dict[str, Any]:
+    """FMU start values of the quiet spin-state step: the chapter's rotor with gravity,
+    levitated (bearing on) on its steady whirl at OMEGA0, the spin a state (J = m R^2/2)."""
+    return {"g": P.g, "integrate_spin": True, "J": J_HALF, "Omega": OMEGA0, "amb_on": 1.0,
+            "start_steady": True}
+
+
+def quiet_fmu_steps() -> dict[str, Any]:
+    """Instructions per 1e-4 s FMU step (callgrind, FMPy's FMU2Slave loop, every output
+    read every step) of the quiet spin-state step, RotorTouchdown against the floor FMU
+    (benchmarks.py), with the inputs held and with T_drive set by a PI drive before every
+    step; each the difference of a 1100- and a 100-step run, in one run of this script."""
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        fmus = B.build_fmus(Path(tmp))
+        data: dict[str, Any] = {"h": H, "start": quiet_start_values(), "pi": QUIET_PI,
+                                "outputs": ([*B.REAL_OUT, "Omega_out"], B.INT_OUT,
+                                            B.BOOL_OUT)}
+        for key, name in (("fmu", "RotorTouchdown"), ("floor", "RotorTouchdownFloor")):
+            unzip, md = fmus[name]
+            data[key] = {"unzip": unzip, "guid": md.guid,
+                         "mid": md.coSimulation.modelIdentifier,
+                         "vr": {v.name: v.valueReference for v in md.modelVariables}}
+        pkl = Path(tmp) / "quiet.pkl"
+        pkl.write_bytes(pickle.dumps(data))
+        script = Path(tmp) / "fmu_child.py"
+        script.write_text(FMU_CHILD)
+        env = {**os.environ, **BI.SINGLE_THREAD}
+        for drive in ("held", "pi"):
+            fmu, floor = (BI.per_unit(script, [str(pkl), w, drive], 100, 1100, env)
+                          for w in ("fmu", "floor"))
+            out[drive] = {"fmu": fmu, "floor": floor, "ratio": fmu / floor, "goal": 1.5}
+            print(f"quiet spin-state step, T_drive {drive:>4s}: RotorTouchdown "
+                  f"{fmu / 1e3:7.1f}k, floor {floor / 1e3:7.1f}k instructions per FMU step, "
+                  f"ratio {fmu / floor:.3f} (goal <= 1.5)", flush=True)
+    return out
 
 
 def drop_start_values() -> dict[str, Any]:
@@ -106,10 +187,19 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--no-valgrind", action="store_true")
+    ap.add_argument("--quiet-only", action="store_true",
+                    help="only count the quiet spin-state FMU step (3.), ~5 min")
     args = ap.parse_args()
+    if args.quiet_only:  # only the quiet spin-state FMU step, into the existing file
+        result = json.loads(OUT.read_text()) if OUT.exists() else {}
+        result["quiet_fmu_step"] = quiet_fmu_steps()
+        OUT.write_text(json.dumps(result, indent=1) + "\n")
+        print(f"wrote {OUT.relative_to(B.ROOT)}")
+        return 0
     result = {"timed": timed(args.repeats)}
     if not args.no_valgrind:
         result["instructions_per_step"] = instructions()
+        result["quiet_fmu_step"] = quiet_fmu_steps()
     OUT.write_text(json.dumps(result, indent=1) + "\n")
     print(f"wrote {OUT.relative_to(B.ROOT)}")
     return 0

@@ -16,7 +16,9 @@ the median of ``--repeats`` runs, so ratios within a run are comparable:
   extracted once, model description read once, ``validate=False``);
 - ``lean@h/k``: a ``FMU2Slave`` loop, doStep at h, all outputs read every k-th step;
 - ``floor-*``: the same host loops on a trivial PythonFMU FMU with the same variables whose
-  ``do_step`` only returns True (the FMI/Python overhead floor);
+  ``do_step`` only publishes constant outputs the way RotorTouchdown publishes a quiet
+  step's (the compiled state publisher, the report's outputs): the FMI/Python overhead
+  floor;
 - ``<METHOD>@rtol``: ``tests/reference/direct.py`` (solve_ivp with events, restart after
   each impact, Zeno cut-off), atol = rtol * (c_r, c_r Omega).
 
@@ -326,7 +328,12 @@ def run_direct(sc: Scene, method: str, rtol: float) -> RunResult:
 
 
 # --------------------------------------------------------------------------- FMUs
-FLOOR_TEMPLATE = '''"""Overhead floor: RotorTouchdown's variables, a do_step that does nothing.
+FLOOR_TEMPLATE = '''"""Overhead floor: RotorTouchdown's variables, a do_step that only publishes.
+
+Its do_step publishes constant outputs the way RotorTouchdown publishes a quiet step's: the
+state outputs through the publisher compiled from the same source
+(rotortd_fmi.touchdown.publisher_source) and the step report's outputs from a constant
+report; so FMU/floor measures the model, not the publishing.
 
 Packaged like RotorTouchdown: this module is resources/rotortd_floor/slave.py, and the FMU
 script (FLOOR_SCRIPT) only subclasses it, since PythonFMU compiles the script per instance.
@@ -340,6 +347,21 @@ REAL_PARAMETERS = {params!r}
 TUNABLE = {tunable!r}
 INPUTS = {inputs!r}
 REAL_OUTPUTS = {outputs!r}
+PUBLISH_SOURCE = {publisher!r}
+STATE_VALUES = {state_values!r}
+_namespace = {{}}
+exec(compile(PUBLISH_SOURCE, "<rotortd_floor.state_publisher>", "exec"), _namespace)
+_publish = _namespace["publish"]
+
+
+class _QuietReport:
+    """A quiet step's report, as the real adapter reads it."""
+    F_contact = 0j
+    F_n = F_n_peak = P_n = T_f = T_imb = 0.0
+    impacts = ()
+
+
+_REPORT = _QuietReport()
 
 
 class RotorTouchdownFloorAdapter(Fmi2Slave):
@@ -373,7 +395,28 @@ class RotorTouchdownFloorAdapter(Fmi2Slave):
                                        variability=disc, initial=exact))
 
     def do_step(self, current_time, step_size):
+        self._publish_state(STATE_VALUES)
+        self._publish_step_outputs(_REPORT)
         return True
+
+    def _publish_state(self, out):
+        """RotorTouchdown's publishing of the state outputs (touchdown.state_publisher, the
+        same compiled source) with constant values."""
+        _publish(self, out, False)
+        return sum(out)
+
+    def _publish_step_outputs(self, rep):
+        """RotorTouchdown's publishing of the step report, from a constant report."""
+        F = rep.F_contact
+        self.F_bx = fx = F.real
+        self.F_by = fy = F.imag
+        self.F_n = F_n = rep.F_n
+        self.F_n_peak = peak = rep.F_n_peak
+        self.P_n = P_n = rep.P_n
+        self.T_f = T_f = rep.T_f
+        self.T_imb = T_imb = rep.T_imb
+        self.n_impacts_step = len(rep.impacts)
+        return fx + fy + F_n + peak + P_n + T_f + T_imb
 '''
 
 FLOOR_SCRIPT = '''"""FMU script of the overhead floor (see rotortd_floor/slave.py)."""
@@ -397,9 +440,12 @@ def _adapter_tables() -> dict[str, Any]:
         return tuple((v.name, v.start, v.description) for v in TABLE
                      if v.causality == causality and v.type == "Real")
 
+    core = TouchdownCore(RotorParams())
     return {"meta": mod.VARIABLE_META, "params": rows("parameter"),
             "tunable": set(mod.TUNABLE), "inputs": rows("input"),
-            "outputs": tuple((n, d) for n, _s, d in rows("output"))}
+            "outputs": tuple((n, d) for n, _s, d in rows("output")),
+            "publisher": mod.publisher_source(core.outputs()._fields),
+            "state_values": tuple(core.output_values())}
 
 
 def build_fmus(tmp: Path) -> dict[str, tuple[str, Any]]:

@@ -68,18 +68,26 @@ def state_publisher(fields: tuple[str, ...]) -> Any:
     the table and the core do not name the same fields."""
     if fields in _publishers:
         return _publishers[fields]
+    namespace: dict[str, Any] = {}
+    exec(compile(publisher_source(fields), "<rotortd_fmi.touchdown.state_publisher>",
+                 "exec"), namespace)
+    _publishers[fields] = namespace["publish"]
+    return namespace["publish"]
+
+
+def publisher_source(fields: tuple[str, ...]) -> str:
+    """The source of ``state_publisher``'s ``publish`` for the field order ``fields``
+    (docs/scripts/benchmarks.py compiles the same into the floor FMU, so that both publish
+    alike). RuntimeError when the table and the fields do not name the same set."""
     by_field = {v.shows: v.name for v in tv.TABLE if v.shows}
     if set(by_field) != set(fields) or len(by_field) != len(fields):
         raise RuntimeError(f"the variable table shows {sorted(by_field)}, the core's state "
                            f"outputs are {sorted(fields)}")
     targets = ", ".join(f"_{f}" if f in ON_EVENTS else f"self.{by_field[f]}" for f in fields)
-    src = (f"def publish(self, out, events):\n    ({targets}) = out\n"
-           "    if events or _mode:\n        self.in_contact = _mode != 0\n"
-           + "".join(f"        self.{by_field[f]} = _{f}\n" for f in fields if f in ON_EVENTS))
-    namespace: dict[str, Any] = {}
-    exec(compile(src, "<rotortd_fmi.touchdown.state_publisher>", "exec"), namespace)
-    _publishers[fields] = namespace["publish"]
-    return namespace["publish"]
+    return (f"def publish(self, out, events):\n    ({targets}) = out\n"
+            "    if events or _mode:\n        self.in_contact = _mode != 0\n"
+            + "".join(f"        self.{by_field[f]} = _{f}\n" for f in fields
+                      if f in ON_EVENTS))
 
 
 class ModelError(ValueError):
@@ -129,6 +137,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._seen_tunables: tuple | None = None
         self._seen_inputs: tuple | None = None
         self._h_spin_warned = False  # h_spin is deprecated: warned once if set
+        self._spin_state = False  # the core's spin_is_state, read once per core
 
     def _watched_setter(self, name: str) -> Any:
         """FMI setter of a parameter or input: stores the value and marks the values as
@@ -158,6 +167,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._check_impact_log()
         try:
             self._core = self._make_core(rotortd)
+            self._spin_state = self._core.spin_is_state
             self._publish = state_publisher(self._core.outputs()._fields)
         except rotortd.CrossParameterError as exc:
             raise ModelError(f"cross-parameter constraint: {exc}") from exc
@@ -277,14 +287,14 @@ class RotorTouchdownAdapter(GuardedSlave):
         if not 0.0 < step_size < math.inf:
             raise ModelError(f"communication step size {step_size!r} s must be finite "
                              f"and > 0")
-        tol = _time_tolerance(current_time, step_size)
+        tol = 1e-9 * max(1.0, abs(current_time)) + 1e-2 * step_size  # (_time_tolerance)
         t = core.t
         if not abs(current_time - t) <= tol:  # also refuses a NaN or infinite time
             raise ModelError(f"communication point {current_time!r} does not match the "
                              f"model time {t!r}")
         omega, f_ext, amb, t_drive = self._step_inputs  # validated by _check_changes
         t_target = t + step_size
-        if core.spin_is_state:
+        if self._spin_state:
             rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
         else:
             rep = core.step(step_size, omega, f_ext, amb)
@@ -419,6 +429,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         fixed_snapshot = dict(adapter["fixed_snapshot"])
         self._core = core
         if core is not None:
+            self._spin_state = core.spin_is_state
             self._publish = state_publisher(core.outputs()._fields)
         for name, value in values.items():
             setattr(self, name, value)

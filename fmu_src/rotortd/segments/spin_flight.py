@@ -96,7 +96,7 @@ from operator import mul
 
 from ..bodies.bearing import CounterBody
 from ..contact.events import Event
-from ..contact.search import WORK_MAX, Work, safe_step
+from ..contact.search import WORK_MAX, Work, _negative_throughout, safe_step
 from ..contact.wall import ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
 
@@ -405,6 +405,10 @@ class SpinFlight:
         self._limit = limit
         if self.closed and not self.moving:
             return self._run_closed(rem, limit, work)
+        if not self.closed and not self.moving and rem <= self.horizon:
+            end = self._run_quiet(rem, limit)  # a short flight proved clear at once
+            if end is not None:
+                return end
         moving, path = self.moving, self.bearing.path if self.moving else None
         if not self.closed:  # (a closed form searched against a moving counter-body)
             self._steps.clear()  # every run integrates afresh: work independent of history
@@ -468,6 +472,92 @@ class SpinFlight:
                 return self._end(s, z, v, dpsi, Om, Event.CONTACT, work)
             s = s + u if u < remaining else rem
             z, v, dpsi, Om, E = self.state(s, work)
+
+    def _run_quiet(self, rem: float, limit: int) -> SegmentEnd | None:
+        """``run`` of a short integrated flight (rem <= the horizon) proved clear of the wall
+        by one bound, then advanced by one Taylor expansion of the order rem needs
+        (``short_taylor``); None when either fails (the caller runs the general search,
+        whose work then starts afresh). The proof is the general loop's first bound with
+        TOL_G added to G: p(u) + TOL_G < 0 on [0, rem], so no point of the step, its end
+        included, is within the contact resolution (docs/model.md 8, "Quiet steps")."""
+        work = Work()
+        z, v, Om, E = self.z0, self.v0, self.Om0, self.E0
+        work.evals += POINT_WORK
+        acc, jerk = self.derivs(z, v, Om, E)
+        ic2 = 1.0 / (self.cr * self.cr)
+        zc = z.conjugate()
+        vc = v.conjugate()
+        az, av = abs(z), abs(v)
+        err = 3.0 * RHO_INT  # the point error of the expansion, as the general loop's
+        g0 = (z * zc).real * ic2 - 1.0 + err + TOL_G
+        if g0 >= 0.0:
+            return None
+        g1 = 2.0 * ((zc * v).real + err * az * av) * ic2
+        g2 = 2.0 * ((v * vc).real + (zc * acc).real + err * (av * av + az * abs(acc))) * ic2
+        g3 = 2.0 * (3.0 * (vc * acc).real + (zc * jerk).real) * ic2
+        work.evals += POINT_WORK
+        tau, G3m, G4m = self.bounds(av, abs(Om), rem)
+        if tau < rem:
+            return None
+        c3 = g3 + 0.25 * rem * G4m + (16.0 * EPS + err) * G3m + TINY
+        if not _negative_throughout(g0, g1, g2, c3, rem):
+            return None
+        end = self.short_taylor(rem)
+        if end is None:
+            return None
+        z, v, dpsi, Om, n = end
+        work.evals += 2 * n + POINT_WORK
+        if work.total > limit:
+            return None
+        return SegmentEnd(rem, z=z, v=v, psi=self.psi0 + dpsi, Omega=Om, work=work.total)
+
+    def short_taylor(self, h: float) -> tuple[complex, complex, float, float, int] | None:
+        """(z, v, psi - psi0, Omega, n) at h (s) from the start, by the Taylor series of
+        the order n that h needs: the recurrences of ``_taylor`` written for the
+        coefficients times h^k (Z_k = z_k h^k, ...), stopped at the first order whose last
+        two terms of the z and Omega series are at most TAYLOR_TOL times their scales (the
+        criterion of a Taylor step of ``_new_step``, met at h itself); None when ORDER
+        does not reach it (docs/model.md 8, "Quiet steps")."""
+        ec, kA = self.ec, self.kA
+        tol_z, tol_o = TAYLOR_TOL * self.cr, TAYLOR_TOL * self.Om_scale
+        E0, Om0, z0 = self.E0, self.Om0, self.z0
+        cAh, hJe, ih = self.cA / h, h * ec / self.J, 1j * h
+        h2m = h * h / self.m
+        Z1 = self.v0 * h
+        Zs = [z0, Z1]
+        E1 = ih * Om0 * E0
+        Er = [E1, E0]  # the E series, newest first: the convolutions need no slicing
+        F0c = (self.F0 - cAh * Z1 - kA * z0).conjugate()
+        Fc = [F0c]  # conj(F_k h^k)
+        O1 = h * (self.T + ec * (F0c * E0).imag) / self.J
+        Os = [Om0, O1]
+        E2 = 0.5j * h * (Om0 * E1 + O1 * E0)
+        Er.insert(0, E2)
+        Zs.append(0.5 * h2m * (F0c.conjugate() - 1j * self.m * self.g) - ec * E2)
+        for k in range(1, ORDER - 1):
+            Fk = -cAh * (k + 1) * Zs[k + 1] - kA * Zs[k]
+            Fc.append(Fk.conjugate())
+            Ok = hJe * sum(map(mul, Fc, Er[1:])).imag / (k + 1)
+            Os.append(Ok)
+            Ek2 = (ih / (k + 2)) * sum(map(mul, Os, Er))
+            Er.insert(0, Ek2)
+            Zk2 = h2m * Fk / ((k + 1) * (k + 2)) - ec * Ek2
+            Zs.append(Zk2)
+            if (abs(Zk2) <= tol_z and abs(Ok) <= tol_o and abs(Zs[k + 1]) <= tol_z
+                    and abs(Os[k]) <= tol_o):
+                break
+        else:
+            return None
+        n = len(Zs) - 1
+        z = v = 0j
+        for j in range(n, 0, -1):  # the small terms first
+            z += Zs[j]
+            v += j * Zs[j]
+        Om = ps = 0.0
+        for j in range(len(Os) - 1, -1, -1):
+            Om += Os[j]
+            ps += Os[j] / (j + 1)
+        return z + z0, v / h, h * ps, Om, n
 
     def _run_closed(self, rem: float, limit: int, work: Work) -> SegmentEnd:
         """``run`` for the closed form: the same steps as the general loop, with the point
@@ -635,6 +725,8 @@ class SpinFlight:
 
 def _check_finite(J: float, **values: complex) -> None:
     """ValueError unless J (kg m^2) is finite and > 0 and every value is finite."""
+    if 0.0 < J < math.inf and cmath.isfinite(sum(values.values())):
+        return  # (the common case at once: a finite sum has finite terms)
     if not (J > 0.0 and math.isfinite(J)):
         raise ValueError(f"J = {J!r} kg m^2: it must be finite and > 0")
     for name, x in values.items():

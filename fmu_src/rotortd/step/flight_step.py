@@ -58,7 +58,12 @@ class FlightSteps:
         caller searches). Either way the step ends in the same state as a search that finds
         nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
-        E = cmath.exp(1j * self._psi)  # (_phasor, inline: the quiet step)
+        psi = self._psi
+        if self._E_of is psi:  # (_phasor, inline: the quiet step; output_values set it)
+            E = self._E_at
+        else:
+            E = self._E_at = complex(math.cos(psi), math.sin(psi))
+            self._E_of = psi
         work = 1
         if not self._clear:
             if self._on_wall:
@@ -102,8 +107,20 @@ class FlightSteps:
         bz, bv, b0, bE = self._imb_free
         return (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
 
+    _E_of: float | None = None
+    """The spin angle object (``_psi``) whose phasor ``_E_at`` holds (identity, not value:
+    a new angle is a new object; 0.0 and -0.0 are told apart)."""
+    _E_at: complex = 1.0 + 0j
+
     def _phasor(self) -> complex:
-        return cmath.exp(1j * self._psi)
+        """e^{i psi}, the same bits as cmath.exp(1j psi) (whose real part is then exp(+-0)
+        = 1: cos psi + i sin psi), computed once per spin angle: the quiet step and
+        output_values share it."""
+        psi = self._psi
+        if self._E_of is not psi:
+            self._E_at = complex(math.cos(psi), math.sin(psi))
+            self._E_of = psi
+        return self._E_at
 
     def _advance_psi(self, ds: float) -> None:
         """Advance the spin angle over ds (s) at the held speed."""

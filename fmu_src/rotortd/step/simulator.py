@@ -65,6 +65,7 @@ __all__ = [
     "restore_core", "work_cap",
 ]
 INF = math.inf
+_NEG_PI = -math.pi
 
 
 class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
@@ -334,11 +335,12 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
             z, v = self._z, self._v
         p, psi = self._p, self._psi
         c_r = p.c_r
-        rot = cmath.exp(-1j * psi)  # scaled.to_scaled inline, bit for bit (test_scaled.py)
+        # scaled.to_scaled inline, bit for bit (test_scaled.py): e^{-i psi} = conj(e^{i psi})
+        rot = self._phasor().conjugate()
         U = z * rot
         den = c_r * W
         dU = (v - 1j * W * z) * rot / den if den != 0.0 else 0j
-        if not (math.isfinite(dU.real) and math.isfinite(dU.imag)):
+        if dU - dU != 0j:  # (an infinite or NaN part: inf - inf is NaN)
             dU = 0j
         r = abs(z)
         rr = r * r
@@ -347,7 +349,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         F_amb = a * (self._bias_force - p.c * v - p.k * z)  # (RotorParams.amb_force inline)
         return (
             z.real, z.imag, v.real, v.imag, r / c_r, U.real / c_r, U.imag / c_r,
-            dU.real, dU.imag, -psi if psi == -math.pi else psi, whirl,
+            dU.real, dU.imag, -psi if psi == _NEG_PI else psi, whirl,
             p.R * W + c_r * whirl, F_amb.real, F_amb.imag,
             W, mode, self._n_impacts, self._t_last, self._v_last, self._E_diss,
         )

@@ -24,7 +24,7 @@ import cmath
 import math
 
 from ..contact.impact import Impact
-from ..contact.search import WORK_MAX
+from ..contact.search import SEGMENT_WORK, WORK_MAX
 from ..contact.wall import SegmentEnd, WallForces
 from ..params import InputError, check_finite
 from ..segments.spin_contact import (
@@ -64,9 +64,13 @@ class SpinSteps:
             self._reject_inputs(h, 0.0, F, amb_on)
             check_finite("T_drive", T_drive, InputError)
         a = float(amb_on)
-        held = HeldInputs(self._p, self._J, a, F, float(T_drive))
         self._inputs = (self._inputs[0], F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
+        if self._mode == MODE_FREE and not self._on_wall:
+            rep = self._spin_quiet_step(h, F, a, float(T_drive), cap)
+            if rep is not None:
+                return rep
+        held = HeldInputs(self._p, self._J, a, F, float(T_drive))
         rep = StepReport()  # (then work_cap: a keyword argument costs 110 ns)
         rep.work_cap = cap
         t0, W0 = self._t, self._inputs[0]
@@ -75,6 +79,31 @@ class SpinSteps:
         s = self._segments(h, t0, rep, st)
         self._finish(rep, t0, s, h, True)
         self._spin_imbalance_torque(rep, W0, held.T_drive, h if s >= h else self._t - t0)
+        return rep
+
+    def _spin_quiet_step(self, h: float, F: complex, a: float, T_drive: float, cap: int
+                         ) -> StepReport | None:
+        """The quiet step: a flight off the wall that ``SpinFlight._run_quiet`` proves clear
+        of it over the whole step with one bound and advances by one short Taylor expansion
+        (docs/model.md 8, "Quiet steps"); the same result, report and work as the step
+        loop's one flight segment that takes that path, without the loop. None when the
+        proof or the expansion does not apply (the step loop then runs)."""
+        W0 = self._inputs[0]
+        fl = SpinFlight(self._p, self._J, a=a, F_ext=F, T_drive=T_drive, z=self._z,
+                        v=self._v, psi=self._psi, Omega=W0)
+        if fl.closed or h > fl.horizon or cap < SEGMENT_WORK:
+            return None
+        end = fl._run_quiet(h, cap - SEGMENT_WORK)
+        if end is None:
+            return None
+        self._z, self._v = end.z, end.v
+        self._spin_advance_spin(end)
+        rep = StepReport()
+        rep.work_cap = cap
+        rep.work = SEGMENT_WORK + end.work
+        t0 = self._t
+        self._finish(rep, t0, h, h, True)
+        self._spin_imbalance_torque(rep, W0, T_drive, h)
         return rep
 
     def _spin_imbalance_torque(self, rep: StepReport, W0: float, T_drive: float,
