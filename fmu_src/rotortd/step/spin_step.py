@@ -89,8 +89,8 @@ class SpinSteps:
         loop's one flight segment that takes that path, without the loop. None when the
         proof or the expansion does not apply (the step loop then runs)."""
         W0 = self._inputs[0]
-        fl = SpinFlight(self._p, self._J, a=a, F_ext=F, T_drive=T_drive, z=self._z,
-                        v=self._v, psi=self._psi, Omega=W0)
+        fl = SpinFlight(self._p, self._J, a, F, T_drive, self._z, self._v, self._psi, W0)
+        # (positional: built every quiet step, and keywords cost 0.85 us a call)
         if fl.closed or h > fl.horizon or cap < SEGMENT_WORK:
             return None
         end = fl._run_quiet(h, cap - SEGMENT_WORK)
