@@ -265,9 +265,20 @@ def sc_old_state(fmu: str, blob_path: str, params: dict, n1: int, n2: int, h: fl
         blob = fh.read()
     run_c = _run_restored(fmu, "old", blob, t_saved, n2, h, inputs)
     doc = json.loads(blob.decode())
+    check = Instance(fmu, "check")  # the old state restored, then saved again at once
+    check.init({})
+    state = check.slave.deSerializeFMUstate(blob)
+    check.slave.setFMUstate(state)
+    check.slave.freeFMUstate(state)
+    again = json.loads(bytes(check.slave.serializeFMUstate(check.slave.getFMUstate())))
+    from rotortd.step.state import CoreState  # the core's reading of the old core state
+
     return {"same": run_a == run_c, "old_core_version": doc["core"]["version"],
             "live_core_version": live_doc["core"]["version"],
-            "modes": sorted({r["mode"] for r in run_a}), "messages": MESSAGES}
+            "restored_core": again["core"],
+            "old_core_read": CoreState.from_json(doc["core"]).to_json(),
+            "modes": sorted({r["mode"] for r in run_a}),
+            "restored_modes": sorted({r["mode"] for r in run_c}), "messages": MESSAGES}
 
 
 def sc_amb_drop(fmu: str, n: int, h: float, t_off: float, g: float = 9.81) -> dict[str, Any]:

@@ -71,7 +71,7 @@ def test_resolvable_crossing_is_located_on_the_circle_at_its_time(excess: float,
                                        Omega0=100.0)
         rep = core.step(0.05, F_ext=0j, amb_on=0.0, T_drive=0.0)
     else:
-        core = TouchdownCore(p, 0j, 1j * vy0)
+        core = TouchdownCore(p, z0=0j, v0=1j * vy0)
         rep = core.step(0.05, 0.0, 0j, 0.0)
     assert rep.status == 0, rep.message
     assert rep.impacts, f"a crossing {excess} c_r deep was missed"
@@ -91,8 +91,8 @@ def test_impacts_of_random_flights_polished_to_their_conditioning() -> None:
     of the mpmath reference (1.4 measured). Without the polish, 19 and 54 (seed 78)."""
     import random
 
-    from rotortd.events import ContactLocator, Work
-    from rotortd.flight import FlightModel
+    from rotortd.contact.search import ContactLocator, Work
+    from rotortd.segments.flight import FlightModel
 
     from tests.reference.mp_reference import mp_first_impact
 
@@ -136,7 +136,7 @@ def test_touch_at_zero_normal_force_is_decided_by_its_rate(rising: bool, whirl: 
     q0 = (0.5 + 0.3j * turn) * kappa * cmath.exp(1j * th)  # per unit m c_r (1/s^2)
     dth = whirl * math.sqrt(kappa - (q0 * cmath.exp(-1j * th)).real)  # Gn = 0
     e = cmath.exp(1j * th)
-    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+    core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * dth * e)
     F = q0 * p.m * p.c_r - p.gravity_force - p.bias_force  # F_ext giving q0 with amb_on = 1
     h = 1e-16 if rising else 1e-4  # rising: N stays within its rounding band 2 steps
     reps = [core.step(h, 0.0, F, 1.0)]
@@ -160,7 +160,7 @@ def _whirl_on_the_wall() -> tuple[TouchdownCore, float]:
     p = BASE.replace(e_c=0.0, mu=0.3)
     th0, w0 = 0.4, 1.6 * math.sqrt(p.k / p.m)
     e = cmath.exp(1j * th0)
-    return TouchdownCore(p, p.c_r * e, 1j * p.c_r * w0 * e), math.sqrt(p.k / p.m)
+    return TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * w0 * e), math.sqrt(p.k / p.m)
 
 
 @pytest.mark.parametrize("past", [1e-12, 1e-11])
@@ -223,7 +223,7 @@ def test_rolling_exits_are_never_stepped_over() -> None:
             1j * rng.uniform(-3.0, 3.0))
         F = q * p.m * p.c_r
         e = cmath.exp(1j * th0)
-        core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+        core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * dth * e)
         rep = core.step(3e-3, W, F, 1.0)
         tr = rep.transitions
         if len(tr) < 2 or tr[0] != (0.0, "rolling"):
@@ -256,7 +256,7 @@ def test_rolling_with_two_phasors_ends_where_they_align(W: float, frac: float) -
     F = -(C - frac * eu) * cmath.exp(1j * th0) * p.m * p.c_r
     assert _rolling_margin(p, F, W, th0, dth, u_align)[0] < 0.0
     e = cmath.exp(1j * th0)
-    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+    core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * dth * e)
     rep = core.step(u_align, W, F, 1.0)
     assert rep.status == 0, rep.message
     assert rep.transitions[0] == (0.0, "rolling") and len(rep.transitions) >= 2, rep.transitions
@@ -287,7 +287,7 @@ def test_no_mode_is_entered_and_left_at_one_instant() -> None:
         q = rng.uniform(0.2, 3.0) * abs(dth * dth - p.k / p.m) * cmath.exp(
             1j * rng.uniform(-3.0, 3.0))
         e = cmath.exp(1j * th0)
-        core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+        core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * dth * e)
         tr: list[tuple[float, str]] = []
         for _ in range(3):
             rep = core.step(3e-3, W, q * p.m * p.c_r, 1.0)
@@ -312,7 +312,7 @@ def test_work_bound_and_segment_weight_are_the_documented_ones() -> None:
     W, th0 = 60.0, 0.4
     dth = -p.R * W / p.c_r
     e = cmath.exp(1j * th0)
-    core = TouchdownCore(p, p.c_r * e, 1j * p.c_r * dth * e)
+    core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * dth * e)
     first = core.step(1e-3, W)
     assert first.transitions[-1][1] == "rolling", first.transitions
     for _ in range(3):
@@ -330,7 +330,7 @@ def test_the_impact_that_starts_contact_is_plastic() -> None:
 
     p = si_params(chapter_params(gamma=0.3))
     assert p.d == 0.95
-    core = TouchdownCore(p, 0j, 0j)
+    core = TouchdownCore(p, z0=0j, v0=0j)
     while core.mode == MODE_FREE:
         rep = core.step(1e-3, OMEGA)
         assert rep.status == 0, rep.message
@@ -348,7 +348,7 @@ def test_f_n_peak_is_the_largest_impact_not_their_sum() -> None:
     the impacts' P_n/h join the peak. A step of impacts only reports the largest one's
     P_n/h (the sum is P_n, reported as F_n = P_n/h)."""
     p = BASE.replace(c=0.1 * BASE.m * 184.2)
-    core = TouchdownCore(p, 0.5 * p.c_r, 0.8j * p.c_r * 184.2)
+    core = TouchdownCore(p, z0=0.5 * p.c_r, v0=0.8j * p.c_r * 184.2)
     h = 0.05
     seen = 0
     for _ in range(10):

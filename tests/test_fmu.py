@@ -162,14 +162,20 @@ def test_state_saved_by_the_previous_version_still_loads(fmu_path: Path, kind: s
                                                          params: dict) -> None:
     """tests/data/fmu_state_v2_<kind>.json: serialised by the FMU of commit 726b1b4 (FMU
     state 2 embedding rotortd-state 2) at 140 ms of the AMB failure scene of
-    test_state_get_set_and_serialize_round_trip; restored into this FMU it continues 60 ms
-    through impacts and contact exactly as this FMU does from the same scene."""
+    test_state_get_set_and_serialize_round_trip. Restored into this FMU and saved again at
+    once, its core state is the old one as the core reads it (version 3, every value
+    kept: tests/test_core_state.py maps them); it continues 60 ms through impacts and
+    contact. With the spin held it continues exactly as this FMU does from the same scene;
+    with the spin a state this FMU's own first 140 ms differ from the old build's at 1e-14
+    (the dry-whirl and quiet-step accelerators), so that comparison does not apply."""
     blob = Path(__file__).resolve().parent / "data" / f"fmu_state_v2_{kind}.json"
     res = run_scenario(fmu_path, "old_state", blob_path=str(blob), params=params, n1=1400,
                        n2=600, h=1e-4, t_off=0.01)
     assert res["old_core_version"] == 2 and res["live_core_version"] == 3
-    assert res["same"], "the old FMU state did not continue as this FMU's run"
-    assert len(res["modes"]) > 1, res["modes"]
+    assert res["restored_core"] == res["old_core_read"]
+    assert len(res["restored_modes"]) > 1, res["restored_modes"]
+    if kind == "held":
+        assert res["same"], "the old FMU state did not continue as this FMU's run"
 
 
 @pytest.mark.parametrize("blob", ["not json", '{"schema": "rotortd-fmu-state", "version": 99}',
