@@ -63,6 +63,8 @@ fmu = FMU2Slave(guid=f["guid"], unzipDirectory=f["unzip"], modelIdentifier=f["mi
                 instanceName="count")
 fmu.instantiate()
 for name, val in D["start"].items():
+    if name not in vr:  # (the floor has no integrate_spin)
+        continue
     if isinstance(val, bool):
         fmu.setBoolean([vr[name]], [val])
     else:

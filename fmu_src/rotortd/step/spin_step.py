@@ -35,7 +35,7 @@ from ..segments.spin_contact import (
     rolling_forces,
     sliding_forces,
 )
-from ..segments.spin_flight import SpinFlight, free_acceleration
+from ..segments.spin_flight import HORIZON, SpinFlight, free_acceleration
 from .flight_step import reference_rate, starts_contact
 from .report import (
     MODE_FREE,
@@ -88,10 +88,13 @@ class SpinSteps:
         (docs/model.md 8, "Quiet steps"); the same result, report and work as the step
         loop's one flight segment that takes that path, without the loop. None when the
         proof or the expansion does not apply (the step loop then runs)."""
-        W0 = self._inputs[0]
-        fl = SpinFlight(self._p, self._J, a, F, T_drive, self._z, self._v, self._psi, W0)
+        W0, p = self._inputs[0], self._p
+        if h * abs(W0) > HORIZON or cap < SEGMENT_WORK or (a == 0.0 and F == 0j):
+            return None  # longer than one bound covers (the horizon is <= HORIZON/|W0|),
+            # or the closed form's flight (bearing off, no external force)
+        fl = SpinFlight(p, self._J, a, F, T_drive, self._z, self._v, self._psi, W0)
         # (positional: built every quiet step, and keywords cost 0.85 us a call)
-        if fl.closed or h > fl.horizon or cap < SEGMENT_WORK:
+        if fl.closed or h > fl.horizon:
             return None
         end = fl._run_quiet(h, cap - SEGMENT_WORK)
         if end is None:
