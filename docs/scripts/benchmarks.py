@@ -32,6 +32,7 @@ import argparse
 import ast
 import cmath
 import gc
+import inspect
 import json
 import math
 import multiprocessing as mproc
@@ -44,6 +45,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import textwrap
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -349,8 +351,10 @@ INPUTS = {inputs!r}
 REAL_OUTPUTS = {outputs!r}
 PUBLISH_SOURCE = {publisher!r}
 STATE_VALUES = {state_values!r}
-_namespace = {{}}
+REPORT_PUBLISH_SOURCE = {report_publisher!r}
+_namespace = {{"Any": object}}
 exec(compile(PUBLISH_SOURCE, "<rotortd_floor.state_publisher>", "exec"), _namespace)
+exec(compile(REPORT_PUBLISH_SOURCE, "<rotortd_floor.report_publisher>", "exec"), _namespace)
 _publish = _namespace["publish"]
 
 
@@ -405,18 +409,7 @@ class RotorTouchdownFloorAdapter(Fmi2Slave):
         _publish(self, out, False)
         return sum(out)
 
-    def _publish_step_outputs(self, rep):
-        """RotorTouchdown's publishing of the step report, from a constant report."""
-        F = rep.F_contact
-        self.F_bx = fx = F.real
-        self.F_by = fy = F.imag
-        self.F_n = F_n = rep.F_n
-        self.F_n_peak = peak = rep.F_n_peak
-        self.P_n = P_n = rep.P_n
-        self.T_f = T_f = rep.T_f
-        self.T_imb = T_imb = rep.T_imb
-        self.n_impacts_step = len(rep.impacts)
-        return fx + fy + F_n + peak + P_n + T_f + T_imb
+    _publish_step_outputs = _namespace["_publish_step_outputs"]  # RotorTouchdown's own
 '''
 
 FLOOR_SCRIPT = '''"""FMU script of the overhead floor (see rotortd_floor/slave.py)."""
@@ -445,6 +438,8 @@ def _adapter_tables() -> dict[str, Any]:
             "tunable": set(mod.TUNABLE), "inputs": rows("input"),
             "outputs": tuple((n, d) for n, _s, d in rows("output")),
             "publisher": mod.publisher_source(core.outputs()._fields),
+            "report_publisher": textwrap.dedent(
+                inspect.getsource(mod.RotorTouchdownAdapter._publish_step_outputs)),
             "state_values": tuple(core.output_values())}
 
 
