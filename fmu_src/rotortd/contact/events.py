@@ -28,3 +28,12 @@ class Event(str, enum.Enum):
     """Sliding (held spin): zero slip that sliding cannot leave; rolling follows."""
     SLIP_START = "slip_start"
     """Rolling: the static friction needed reaches mu N (the friction cone's edge)."""
+    SEPARATE = "separate"
+    """Contact, compliant law: the penetration reaches 0 (the contact opens)."""
+    CLAMP_END = "clamp_end"
+    """Contact, compliant law: the law's value, clamped at 0 inside the penetration, is
+    positive again."""
+    RACE_STOP = "race_stop"
+    """Contact, turning race with static friction: its spin reaches 0."""
+    BREAKAWAY = "breakaway"
+    """Contact, race held at rest: the static torque that holds it reaches T_b0."""

@@ -61,6 +61,12 @@ class StepReport:
     T_imb: float = 0.0
     """Imbalance reaction torque on the spin (N m), step average P_imb/h: a drivetrain that
     owns the spin inertia integrates J Omega' = T_drive + T_f + T_imb."""
+    P_support: complex = 0j
+    """Real bearing (docs/model.md §10): impulse (N s) of the force the race's support
+    passes to the frame over the step (with a rigid support, the contact's on the race)."""
+    E_fric: float = 0.0
+    """Real bearing: friction heat put into the contact over the step (J), impacts' share
+    included."""
 
     def add_impact(self, imp: Impact, n: complex) -> None:
         """Add an impact at the unit contact normal n (inertial): the impact itself, its

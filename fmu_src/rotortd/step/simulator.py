@@ -25,6 +25,7 @@ import cmath
 import math
 
 from ..bodies.bearing import FixedRigidBearing
+from ..bodies.race import BearingParams, RealRace
 from ..bodies.rotor import RigidRotor, check_well_posed
 from ..contact.pair import ContactPair
 from ..contact.search import SEGMENT_WORK, WORK_MAX
@@ -32,8 +33,10 @@ from ..contact.wall import ContactWorkExceeded, WallForces, phase_integral
 from ..limits import CrossParameterError, start_position
 from ..params import InputError, ParameterError, RotorParams, check_finite, check_range
 from ..scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
+from ..segments.bearing_contact import ContactState
 from ..segments.flight import FlightModel
 from ..segments.rub import RubEquilibrium
+from .bearing_step import BearingSteps
 from .contact_step import LOCK_TOL, RUB_RETRY, ContactSteps
 from .flight_step import ETA_HEIGHT, ETA_TIME, N_CASCADE, FlightSteps
 from .report import (
@@ -68,15 +71,18 @@ INF = math.inf
 _NEG_PI = -math.pi
 
 
-class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
+class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
     """Rotor in a touchdown bearing, advanced step by step (see the module docstring).
 
     J (kg m^2, > 0): the polar inertia about the mass centre; inf (the default) holds the
     spin (Omega an input of each step), a finite J makes it a state starting at Omega0
     (rad/s; CrossParameterError when J is too small for the contact to be well posed).
     z0 (m), v0 (m/s): the rotor centre's start (inertial); psi0 (rad) the spin angle;
-    t0 (s) the clock."""
+    t0 (s) the clock. ``bearing``: the real touchdown bearing's options (docs/model.md §10;
+    ``bodies.race.BearingParams``); None or all options off is the chapter's fixed rigid
+    bearing. The options need the spin as a state (J finite)."""
 
+    _race: RealRace | None = None  # the real bearing's race (None: the fixed rigid one)
     _pair: ContactPair | None = None  # the contact pair, built for _pair_of (params, J)
     _pair_of: tuple[RotorParams, float] | None = None
 
@@ -90,6 +96,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         psi0: float = 0.0,
         Omega0: float = 0.0,
         t0: float = 0.0,
+        bearing: BearingParams | None = None,
     ) -> None:
         z0, v0 = complex(z0), complex(v0)
         for name, val in (
@@ -133,7 +140,23 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         bit. A setting of the object, not of the
         state (get_state and set_state leave it as it is)."""
         self._set_inputs(float(Omega0), 0j, 1.0)  # the flight and wall models of the inputs
+        if bearing is not None and bearing.any_option:
+            self._use_bearing(bearing)
         self._bind_rotor()
+
+    def _use_bearing(self, bp: BearingParams) -> None:
+        """Put the rotor in the real bearing ``bp`` (its race at rest at the origin,
+        turning at omega_b0)."""
+        if self._J == INF:
+            raise CrossParameterError(
+                "the real bearing's options (race_turns, support_compliant, "
+                "contact_compliant) need the spin as a state (a finite J): a held spin "
+                "would make the race's catching up, which brakes the rotor, do no work on it")
+        bp.check(self._p.d)
+        self._race = RealRace(bp, c_r=self._p.c_r, R=self._p.R)
+        self._law = self._bearing_law()
+        self._c_d = self._bearing_c_d()
+        self._cstate = ContactState(1.0)
 
     _SPIN_STATE_CHOICES = (("step", "_spin_step"), ("_advance_free", "_spin_advance_free"),
                            ("_advance_contact", "_spin_advance_contact"),
@@ -141,18 +164,26 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
                            ("_roll_or_slide", "_spin_roll_or_slide"),
                            ("_cone_sign", "_spin_cone_sign"))
     """The choices bound in place of the held spin's when the spin is a state."""
+    _BEARING_CHOICES = (("_advance_free", "_bearing_advance_free"),
+                        ("_advance_contact", "_bearing_advance_contact"),
+                        ("_wall_state", "_bearing_wall_state"),
+                        ("_spin_quiet_step", "_bearing_quiet_step"))
+    """The choices bound in place of the fixed bearing's when a real bearing's option is on
+    (after the spin state's)."""
 
     def _bind_rotor(self) -> None:
         """Bind the segment choices of the rotor's spin model: the held spin's are the
         class's own (FlightSteps, ContactSteps); with the spin a state (J finite) the
         instance takes SpinSteps' in their place (``_SPIN_STATE_CHOICES``: its step entry
-        and segment choices), for the same step loop."""
-        held = self._J == INF
-        for name, spin in self._SPIN_STATE_CHOICES:
-            if held:
-                self.__dict__.pop(name, None)
-            else:
-                setattr(self, name, getattr(self, spin))
+        and segment choices), and with a real bearing BearingSteps' after them
+        (``_BEARING_CHOICES``), for the same step loop."""
+        for name, _ in self._SPIN_STATE_CHOICES + self._BEARING_CHOICES:
+            self.__dict__.pop(name, None)
+        choices = () if self._J == INF else self._SPIN_STATE_CHOICES
+        if self._race is not None:
+            choices += self._BEARING_CHOICES
+        for name, choice in choices:
+            setattr(self, name, getattr(self, choice))
 
     @classmethod
     def from_scaled(
@@ -225,6 +256,12 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         return self._J
 
     @property
+    def race(self) -> RealRace | None:
+        """The real bearing's race (``bodies.race.RealRace``: its centre, spin, heats);
+        None for the chapter's fixed rigid bearing."""
+        return self._race
+
+    @property
     def spin_is_state(self) -> bool:
         """The spin speed is a state (J finite) or a held input (J = inf)."""
         return self._J != INF
@@ -241,6 +278,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
         normal, speeds, W, impact law."""
         p, J = self._p, self._J
         key = self._pair_of
+        if self._race is not None:
+            return ContactPair(RigidRotor(p.m, J, p.e_c, p.phi, p.R), self._race)
         if key is None or key[0] is not p or key[1] != J:
             self._pair = ContactPair(RigidRotor(p.m, J, p.e_c, p.phi, p.R),
                                      FixedRigidBearing(c_r=p.c_r))
@@ -572,7 +611,9 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
             imb_h=(self._imb_seen_h, self._imb_free_h),
             Omega=self._inputs[0], F_ext=self._inputs[1], amb_on=self._inputs[2],
-            bearing=fixed_bearing_record(), J=None if self._J == INF else self._J,
+            bearing=(fixed_bearing_record() if self._race is None
+                     else self._bearing_record()),
+            J=None if self._J == INF else self._J,
         )
 
     def get_state(self) -> dict:
@@ -593,11 +634,23 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps):
                 f"{'SpinCore' if cs.J is not None else 'TouchdownCore'} (rotortd.restore_core)")
         if cs.J is not None:
             check_well_posed(cs.params, cs.J)
-        if dict(cs.bearing) != fixed_bearing_record():
+        real = dict(cs.bearing).get("kind") == RealRace.KIND
+        if not real and dict(cs.bearing) != fixed_bearing_record():
             raise ParameterError(
-                f"the state's bearing record {dict(cs.bearing)!r} is not of this core's "
-                f"bearing {fixed_bearing_record()!r} (bearing.FixedRigidBearing)")
+                f"the state's bearing record {dict(cs.bearing)!r} is neither the fixed "
+                f"rigid bearing's {fixed_bearing_record()!r} nor a real bearing's")
+        p_old, race_old = self._p, self._race
         self._p = cs.params
+        try:
+            if real:
+                self._restore_bearing(dict(cs.bearing))
+        except ParameterError:
+            self._p = p_old
+            raise
+        if not real:
+            self._race = None
+        if self._race is not race_old:
+            self._bind_rotor()
         if cs.J is not None:
             self._J = cs.J
         self._t, self._t_lo = cs.t, cs.t_lo
