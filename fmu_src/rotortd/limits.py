@@ -64,6 +64,16 @@ LIMITS: dict[str, Limit] = {
     # spin (rotortd_drive)
     "J": Limit("kg.m2", 1e-9, 1e7),
     "h_spin": Limit("s", 1e-8, 1.0),
+    # the real bearing (bodies.race.BearingParams, docs/model.md §10)
+    "J_b": Limit("kg.m2", 1e-8, 1e3),
+    "T_b0": Limit("N.m", 0.0, 1e4),
+    "c_bw": Limit("N.m.s", 0.0, 1e3),
+    "omega_b0": Limit("rad/s", -1e5, 1e5),
+    "m_b": Limit("kg", 1e-3, 1e5),
+    "k_b": Limit("N/m", 1e3, 1e11),
+    "c_b": Limit("N.s/m", 0.0, 1e8),
+    "k_c": Limit("N/m", 1e5, 1e12),
+    "p_c": Limit("1", 1.0, 1.5),
     # inputs held over a step
     "Omega": Limit("rad/s", -1e5, 1e5),
     "F_x": Limit("N", -1e12, 1e12),

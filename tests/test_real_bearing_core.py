@@ -1,0 +1,190 @@
+"""The core's real touchdown bearing (docs/model.md §10) against the independent reference
+(tests/reference/real_bearing.py, which shares no code with fmu_src) and the closed forms
+of §10: the drop of issue 24 impact by impact, a single compliant impact, a rigid impact on
+a sprung race, the balances, the state round trip and the refusals.
+
+Tolerances come from measured sensitivity: on the drop's first 20 ms the reference at
+rtol 1e-12 and at 1e-13 differ by 2e-13 c_r in z, 8e-13 rad/s in Omega and 1.6e-10 rad/s in
+omega_b (the race's small inertia amplifies); the core differs from the 1e-12 reference by
+3.4e-13 c_r, 3.4e-12 rad/s and 1.5e-10 rad/s."""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import pytest
+from rotortd import restore_core
+from rotortd.bodies.race import BearingParams
+from rotortd.limits import CrossParameterError, ParameterError
+from rotortd.params import RotorParams
+from rotortd.step.simulator import TouchdownCore
+
+from tests.reference import real_bearing as rb
+
+W0 = 184.2
+ALL_ON = {"race_turns": True, "support_compliant": True, "contact_compliant": True}
+
+
+def _drop_core(**opts: object) -> TouchdownCore:
+    """The issue's drop: the chapter's rotor with gravity, mu 0.15, d 0.9, J = m R^2/2, from
+    the levitated whirl at 184.2 rad/s with the bearing failed at t = 0."""
+    p = RotorParams(g=9.81, d=0.9, mu=0.15)
+    Z1 = p.m * p.e_c * W0**2 * cmath.exp(1j * p.phi) / (p.k - p.m * W0**2 + 1j * p.c * W0)
+    return TouchdownCore(p, J=0.04, z0=Z1, v0=1j * W0 * Z1, Omega0=W0,
+                         bearing=BearingParams(**{**ALL_ON, **opts}))
+
+
+def _contact_changes(transitions: list[tuple[float, str]]) -> list[tuple[float, str]]:
+    """The reference's mode changes of the contact (its race changes dropped), named as the
+    core's: free -> lift_off, slide -> sliding, stick -> rolling."""
+    names = {"free": "lift_off", "slide+": "sliding", "slide-": "sliding", "stick": "rolling"}
+    out: list[tuple[float, str]] = []
+    for t, m in transitions:
+        kind = names.get(m.split("/")[0], m)
+        if t > 0.0 and (not out or out[-1][1] != kind):
+            out.append((t, kind))
+    return out
+
+
+def test_drop_agrees_with_the_reference_impact_by_impact() -> None:
+    T, h = 0.02, 1e-4
+    ref = rb.drop_scene(t_end=T, n_grid=round(T / h) + 1)
+    core = _drop_core()
+    ez = eW = ewb = ezb = 0.0
+    peak, trans = 0.0, []
+    c_r = core.params.c_r
+    for i in range(1, round(T / h) + 1):
+        rep = core.step(h, None, 0j, 0.0, T_drive=0.0)
+        assert rep.status == 0
+        peak = max(peak, rep.F_n_peak)
+        trans += rep.transitions
+        y = ref.y[i]
+        race = core.race
+        assert race is not None
+        ez = max(ez, abs(core.z - complex(y[0], y[1])) / c_r)
+        eW = max(eW, abs(core.Omega - y[5]))
+        ewb = max(ewb, abs(race.omega_b - y[10]))
+        ezb = max(ezb, abs(race.z_b - complex(y[6], y[7])) / c_r)
+    assert ez <= 3e-12 and ezb <= 3e-12, (ez, ezb)
+    assert eW <= 4e-11, eW
+    assert ewb <= 2e-9, ewb
+    expected = _contact_changes(ref.transitions)
+    assert [m for _, m in trans] == [m for _, m in expected]
+    assert max(abs(t - te) for (t, _), (te, _) in zip(trans, expected)) <= 1e-12
+    assert peak == pytest.approx(ref.N_peak, rel=1e-9)
+    assert 4.4e-3 < next(t for t, m in trans if m == "rolling") < 4.5e-3  # the race caught up
+
+
+def _single_impact_core(p_c: float, d: float, v_in: float) -> tuple[TouchdownCore, float]:
+    """A normal compliant impact on a fixed rigid race: no friction, imbalance, gravity or
+    AMB; the rotor starts 0.1 c_r inside the circle moving outward at v_in."""
+    p = RotorParams(e_c=0.0, g=0.0, mu=0.0, d=d, levitate=False)
+    bp = BearingParams(contact_compliant=True, p_c=p_c, k_c=1e9)
+    x0 = 0.9 * p.c_r
+    core = TouchdownCore(p, J=0.04, z0=x0, v0=v_in, bearing=bp)
+    return core, (p.c_r - x0) / v_in
+
+
+@pytest.mark.parametrize(("p_c", "d"), [(1.0, 0.9), (1.5, 0.9), (1.0, 1.0), (1.5, 0.5)])
+def test_single_compliant_impact_matches_its_closed_form(p_c: float, d: float) -> None:
+    v_in = 0.1
+    core, t_close = _single_impact_core(p_c, d, v_in)
+    exact = rb.single_impact(core.params.m, v_in, 1e9, p_c, d)
+    rep = core.step(t_close + 2.0 * exact.T, None, 0j, 0.0, T_drive=0.0)
+    (t1, m1), (t2, m2) = rep.transitions
+    assert (m1, m2) == ("sliding", "lift_off")
+    assert t1 == pytest.approx(t_close, rel=1e-14)
+    assert t2 - t1 == pytest.approx(exact.T, rel=2e-11)
+    assert rep.F_n_peak == pytest.approx(exact.N_max, rel=2e-11)
+    v_out = -core.v.real
+    tol = 5e-14 if p_c == 1.0 else 1e-11  # delta^{3/2} is not smooth at the contact's ends
+    assert v_out == pytest.approx(d * v_in, rel=tol)
+    assert rep.impacts == []  # a compliant contact has no impulse
+
+
+def test_rigid_impact_on_a_sprung_race_matches_its_closed_form() -> None:
+    p = RotorParams(e_c=0.0, g=0.0, mu=0.0, d=0.95, levitate=False)
+    bp = BearingParams(support_compliant=True, m_b=2.0, k_b=5e7, c_b=2e3)
+    v_in = 0.1
+    core = TouchdownCore(p, J=0.04, z0=0.5 * p.c_r, v0=v_in, bearing=bp)
+    rep = core.step(0.5 * p.c_r / v_in * (1.0 + 1e-9), None, 0j, 0.0, T_drive=0.0)
+    (imp,) = rep.impacts
+    rotor, race = rb.rigid_impact_sprung(p.m, bp.m_b, p.d, v_in)
+    assert imp.v_plus.real == pytest.approx(rotor, rel=1e-14)
+    assert imp.P_n == pytest.approx(p.m * (v_in - rotor), rel=1e-14)
+    assert imp.P_n / bp.m_b == pytest.approx(race, rel=1e-14)  # the race's kick
+
+
+def _energy(core: TouchdownCore) -> float:
+    """Mechanical energy (J) of rotor and race with the AMB off (docs/model.md §10)."""
+    p, race = core.params, core.race
+    assert race is not None
+    bp = race.params
+    E = cmath.exp(1j * (core.psi + p.phi))
+    vG = core.v + 1j * core.Omega * p.e_c * E
+    zG = core.z + p.e_c * E
+    delta = abs(core.z - race.z_b) - p.c_r
+    V_c = 0.0
+    if bp.contact_compliant and delta > 0.0:
+        K = bp.k_c * 1e-5 ** (1.0 - bp.p_c)
+        V_c = K * delta ** (bp.p_c + 1.0) / (bp.p_c + 1.0)
+    return (0.5 * p.m * abs(vG) ** 2 + 0.5 * core.J * core.Omega**2
+            + 0.5 * bp.m_b * abs(race.v_b) ** 2 * bp.support_compliant
+            + 0.5 * bp.J_b * race.omega_b**2 * bp.race_turns
+            + p.m * p.g * zG.imag + 0.5 * bp.k_b * abs(race.z_b) ** 2 * bp.support_compliant
+            + V_c)
+
+
+@pytest.mark.parametrize("opts", [{}, {"contact_compliant": False, "support_compliant": False}])
+def test_energy_balance_closes_over_the_drop(opts: dict[str, bool]) -> None:
+    """E(0) - E(t) = contact heat (impacts, damping, friction) + race drag + support damper,
+    to 1e-9 of the sum of the magnitudes of the terms."""
+    core = _drop_core(**opts)
+    E0, heat = _energy(core), 0.0
+    for _ in range(150):
+        rep = core.step(1e-4, None, 0j, 0.0, T_drive=0.0)
+        assert rep.status == 0
+        heat += rep.E_diss
+    race = core.race
+    assert race is not None
+    terms = [E0, _energy(core), heat, race.E_drag, race.E_support]
+    resid = E0 - _energy(core) - heat - race.E_drag - race.E_support
+    assert abs(resid) <= 1e-9 * sum(abs(x) for x in terms), (resid, terms)
+    assert heat > 0.0
+
+
+def test_state_round_trip_mid_contact_continues_bit_for_bit() -> None:
+    a = _drop_core()
+    for _ in range(30):  # into the second contact (sliding, the race turning)
+        a.step(1e-4, None, 0j, 0.0, T_drive=0.0)
+    assert a.mode != 0
+    b = restore_core(a.get_state())
+    for _ in range(30):
+        ra = a.step(1e-4, None, 0j, 0.0, T_drive=0.0)
+        rb_ = b.step(1e-4, None, 0j, 0.0, T_drive=0.0)
+        assert ra.F_n_peak == rb_.F_n_peak
+    assert a.output_values() == b.output_values()
+    assert a.race is not None and b.race is not None
+    assert a.race.record() == b.race.record()
+
+
+def test_options_need_the_spin_as_a_state() -> None:
+    with pytest.raises(CrossParameterError, match="spin as a state"):
+        TouchdownCore(RotorParams(), bearing=BearingParams(race_turns=True))
+    held = TouchdownCore(RotorParams(), bearing=BearingParams())  # all off: the chapter's
+    assert held.race is None
+
+
+def test_bad_bearing_parameters_are_refused_with_their_range() -> None:
+    p = RotorParams()
+    with pytest.raises(ParameterError, match=r"d = 0 is refused under the compliant"):
+        TouchdownCore(RotorParams(d=0.0), J=0.04,
+                      bearing=BearingParams(contact_compliant=True))
+    with pytest.raises(ParameterError,
+                       match=r"k_b = 10000000000000.0 N/m is out of range.*1e\+11\] N/m"):
+        TouchdownCore(p, J=0.04, bearing=BearingParams(support_compliant=True, k_b=1e13))
+    with pytest.raises(ParameterError, match=r"p_c = 1\.2"):
+        TouchdownCore(p, J=0.04, bearing=BearingParams(contact_compliant=True, p_c=1.2))
+    with pytest.raises(ParameterError, match="J_b = nan"):
+        TouchdownCore(p, J=0.04, bearing=BearingParams(race_turns=True, J_b=math.nan))
