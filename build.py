@@ -67,6 +67,7 @@ BASE_UNITS: dict[str, dict[str, int]] = {
     "J": {"kg": 1, "m": 2, "s": -2},
     "kg.m2": {"kg": 1, "m": 2},
     "N.m.s": {"kg": 1, "m": 2, "s": -1},
+    "W": {"kg": 1, "m": 2, "s": -3},
 }
 
 

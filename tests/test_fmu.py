@@ -148,7 +148,7 @@ def test_state_get_set_and_serialize_round_trip(fmu_path: Path) -> None:
     current core this crosses impacts and sustained contact (sliding, rolling)."""
     res = run_scenario(fmu_path, "state_roundtrip", params={"g": 9.81}, n1=1400, n2=600,
                        h=1e-4, t_off=0.01)
-    assert res["schema"] == "rotortd-fmu-state" and res["version"] == 2
+    assert res["schema"] == "rotortd-fmu-state" and res["version"] == 3
     assert res["has_core"] and res["core_schema"] == "rotortd-state"
     assert res["same_get_set"], "get/set FMU state did not reproduce the run bit for bit"
     assert res["same_serialized"], "serialize/deserialize did not reproduce the run"
@@ -314,7 +314,7 @@ def test_state_round_trip_with_the_spin_as_a_state(fmu_path: Path) -> None:
     res = run_scenario(fmu_path, "state_roundtrip",
                        params={"g": 9.81, "integrate_spin": True, "J": 0.04},
                        n1=1400, n2=600, h=1e-4, t_off=0.01)
-    assert res["version"] == 2 and res["has_core"]
+    assert res["version"] == 3 and res["has_core"]
     assert res["same_get_set"] and res["same_serialized"]
     assert res["modes"] == [0, 1, 2] and res["n_impacts_at_save"] > 10
 

@@ -3,9 +3,11 @@
 Pure Python on ``math``/``cmath`` (no numpy, no pythonfmu), so it is fast for scalar
 work and safe inside any FMI host. SI units and the inertial frame unless stated.
 The FMU adapter (``fmu_src/rotortd_fmi/touchdown.py``) is a thin layer over ``TouchdownCore``
-(the spin held over each step) and ``SpinCore`` (the spin as a state, docs/model.md §8).
+(the spin held over each step) and ``SpinCore`` (the spin as a state, docs/model.md §8),
+with the chapter's fixed rigid bearing or a real one (``BearingParams``, docs/model.md §10).
 """
 
+from .bodies.race import BearingParams, RealRace
 from .contact.impact import Impact
 from .contact.wall import WallForces
 from .limits import LIMITS, CrossParameterError, Limit
@@ -35,12 +37,14 @@ __all__ = [
     "STATUS_WORK_CAP",
     "TUNABLE",
     "WORK_MAX",
+    "BearingParams",
     "CrossParameterError",
     "Impact",
     "InputError",
     "Kinematics",
     "Limit",
     "ParameterError",
+    "RealRace",
     "RotorParams",
     "RubEquilibrium",
     "ScaledParams",

@@ -37,9 +37,11 @@ from .guard import GuardedSlave
 from .variables import meta, range_violations, register
 
 STATE_SCHEMA = "rotortd-fmu-state"
-STATE_VERSION = 2
-"""Version 2: the spin state (integrate_spin) is in the core's state; version 1 states of
-a held-speed instance still load, those of the former sub-stepped spin coupler do not. The
+STATE_VERSION = 3
+"""Version 3: the real bearing's variables (``touchdown_variables.REAL_BEARING``); states of
+versions 1 and 2 lack them and restore with their start values (all options off). Version
+2: the spin state (integrate_spin) is in the core's state; version 1 states of a
+held-speed instance still load, those of the former sub-stepped spin coupler do not. The
 core's state under "core" carries its own schema and version (``rotortd.step.state``: written
 as rotortd-state 3, by component; FMU states embedding rotortd-state 1 or 2 still load)."""
 
@@ -180,16 +182,22 @@ class RotorTouchdownAdapter(GuardedSlave):
         outside the clearance is projected onto it (rotortd.limits.start_position)."""
         params = self._make_params(rotortd)
         omega, f_ext, amb, _t_drive = self._input_values()
+        bearing = self._make_bearing(rotortd)
+        if bearing is not None and not self.integrate_spin:
+            raise ModelError(
+                "race_turns, support_compliant and contact_compliant need integrate_spin = "
+                "true: the real bearing's race brakes or spins up the rotor, which a held "
+                "spin cannot show (docs/model.md §10)")
         if self.integrate_spin:  # the spin is a state; Omega is its initial value
             J = float(self.J)
             if self.start_steady:
                 return rotortd.SpinCore.on_steady_whirl(
                     params, omega, F_ext=f_ext, amb_on=amb, psi0=float(self.psi0),
-                    t0=self._t0, J=J)
+                    t0=self._t0, J=J, bearing=bearing)
             return rotortd.SpinCore(
                 params, J, z0=complex(float(self.x0), float(self.y0)),
                 v0=complex(float(self.vx0), float(self.vy0)), psi0=float(self.psi0),
-                Omega0=omega, t0=self._t0)
+                Omega0=omega, t0=self._t0, bearing=bearing)
         if self.start_steady:
             return rotortd.TouchdownCore.on_steady_whirl(
                 params, omega, F_ext=f_ext, amb_on=amb, psi0=float(self.psi0), t0=self._t0)
@@ -225,6 +233,21 @@ class RotorTouchdownAdapter(GuardedSlave):
         kwargs = {f.name: float(getattr(self, f.name)) for f in fields(rotortd.RotorParams)
                   if f.name != "levitate"}
         return rotortd.RotorParams(levitate=bool(self.levitate), **kwargs)
+
+    def _make_bearing(self, rotortd: Any) -> Any:
+        """The real bearing's options (``rotortd.BearingParams``), None when all are off
+        (the chapter's fixed rigid bearing). A value the core refuses (p_c not 1 or 1.5,
+        d = 0 under the compliant law) is a ModelError naming it."""
+        kwargs = {f.name: getattr(self, f.name) for f in fields(rotortd.BearingParams)}
+        bp = rotortd.BearingParams(**{k: bool(v) if isinstance(v, bool) else float(v)
+                                      for k, v in kwargs.items()})
+        if not bp.any_option:
+            return None
+        try:
+            bp.check(float(self.d))
+        except rotortd.ParameterError as exc:
+            raise ModelError(str(exc)) from exc
+        return bp
 
     def _fixed_values(self) -> dict[str, Any]:
         return dict(zip(FIXED, _get_fixed(self)))
@@ -351,8 +374,9 @@ class RotorTouchdownAdapter(GuardedSlave):
         the first step, rep None); return the sum of the averages (inf or NaN if any is)."""
         if rep is None:
             self.F_bx = self.F_by = self.F_n = self.F_n_peak = self.P_n = self.T_f = 0.0
-            self.T_imb = 0.0
+            self.T_imb = self.F_sx = self.F_sy = self.P_fric = 0.0
             self.n_impacts_step = 0
+            self._publish_race(None)
             return 0.0
         F = rep.F_contact
         self.F_bx = fx = F.real
@@ -363,7 +387,28 @@ class RotorTouchdownAdapter(GuardedSlave):
         self.T_f = T_f = rep.T_f
         self.T_imb = T_imb = rep.T_imb
         self.n_impacts_step = len(rep.impacts)
-        return fx + fy + F_n + peak + P_n + T_f + T_imb
+        if self._core.race is None:  # the fixed bearing passes the contact force on
+            self.F_sx, self.F_sy = -fx, -fy
+            return fx + fy + F_n + peak + P_n + T_f + T_imb
+        return fx + fy + F_n + peak + P_n + T_f + T_imb + self._publish_race(rep)
+
+    def _publish_race(self, rep: Any) -> float:
+        """Publish the real bearing's outputs (zeros for the fixed bearing); return their
+        sum (for the non-finite check)."""
+        race = None if self._core is None else self._core.race
+        if race is None:
+            self.omega_b = self.x_b = self.y_b = self.vx_b = self.vy_b = 0.0
+            self.E_fric = self.E_drag = 0.0
+            return 0.0
+        self.omega_b = race.omega_b
+        self.x_b, self.y_b = race.z_b.real, race.z_b.imag
+        self.vx_b, self.vy_b = race.v_b.real, race.v_b.imag
+        self.E_fric, self.E_drag = race.E_fric, race.E_drag
+        if rep is not None:
+            self.F_sx, self.F_sy = rep.F_support.real, rep.F_support.imag
+            self.P_fric = rep.P_fric
+        return (self.omega_b + self.x_b + self.y_b + self.vx_b + self.vy_b + self.E_fric
+                + self.E_drag + self.F_sx + self.F_sy + self.P_fric)
 
     def _append_impacts(self, impacts: list[Any]) -> None:
         with self._open_impact_log() as fh:
@@ -405,7 +450,7 @@ class RotorTouchdownAdapter(GuardedSlave):
     def _restore(self, state: dict[str, Any]) -> None:
         if not isinstance(state, dict) or state.get("schema") != STATE_SCHEMA:
             raise ModelError("not a rotortd FMU state (schema mismatch)")
-        if state.get("version") not in (1, STATE_VERSION):
+        if state.get("version") not in (1, 2, STATE_VERSION):
             raise ModelError(f"unsupported FMU state version {state.get('version')!r}")
         if state["version"] == 1 and state.get("adapter", {}).get("spin") is not None:
             raise ModelError("the state was saved by the former sub-stepped spin coupler "
@@ -415,6 +460,8 @@ class RotorTouchdownAdapter(GuardedSlave):
             raise ModelError(f"the saved state is invalid: {state['invalid']}")
         known = {v.name for v in self.vars.values()}
         values = state["variables"]
+        if isinstance(values, dict) and state["version"] < 3:  # before the real bearing
+            values = {**{n: tv.BY_NAME[n].start for n in tv.REAL_BEARING}, **values}
         if not isinstance(values, dict) or set(values) != known:
             raise ModelError("FMU state does not list exactly this model's variables")
         core_state, adapter = state["core"], state["adapter"]
@@ -425,6 +472,10 @@ class RotorTouchdownAdapter(GuardedSlave):
             core = rotortd.restore_core(copy.deepcopy(core_state))
             if bool(values["integrate_spin"]) != core.spin_is_state:
                 raise ModelError("the core state does not match integrate_spin")
+            real = any(bool(values[n]) for n in ("race_turns", "support_compliant",
+                                                  "contact_compliant"))
+            if real != (core.race is not None):
+                raise ModelError("the core state does not match the bearing's options")
         t0, failure = float(adapter["t0"]), str(adapter["failure"])
         fixed_snapshot = dict(adapter["fixed_snapshot"])
         self._core = core

@@ -54,11 +54,14 @@ TABLE: tuple[Var, ...] = (
     limited("T_drive", INPUT, 0.0, "Drive torque on the rotor (motor minus drag), held "
                                    "over the step, used if integrate_spin"),
     # outputs
-    output("x", "m", "Rotor centre position x, inertial, |(x, y)| <= c_r", shows="x"),
-    output("y", "m", "Rotor centre position y, inertial, |(x, y)| <= c_r", shows="y"),
+    output("x", "m", "Rotor centre position x, inertial, |(x, y)| <= c_r while the race's "
+                     "centre stays at the origin", shows="x"),
+    output("y", "m", "Rotor centre position y, inertial, |(x, y)| <= c_r while the race's "
+                     "centre stays at the origin", shows="y"),
     output("vx", "m/s", "Rotor centre velocity x, inertial", shows="vx"),
     output("vy", "m/s", "Rotor centre velocity y, inertial", shows="vy"),
-    output("r_rel", "1", "Radial position relative to clearance r/c_r", 0.0, shows="r_rel"),
+    output("r_rel", "1", "Radial position relative to clearance r/c_r, r measured from the "
+                         "race's centre", 0.0, shows="r_rel"),
     output("u_re", "1", "Co-rotating scaled position Re U, U = z exp(-i psi)/c_r, |U| <= 1",
            shows="u_re"),
     output("u_im", "1", "Co-rotating scaled position Im U, |U| <= 1", shows="u_im"),
@@ -67,16 +70,19 @@ TABLE: tuple[Var, ...] = (
     output("du_im", "1", "Co-rotating scaled velocity Im dU/dt, t = Omega tau; 0 when "
                          "Omega = 0", shows="du_im"),
     output("psi", "rad", "Spin angle wrapped to (-pi, pi]", shows="psi_wrapped"),
-    output("whirl_rate", "rad/s", "Inertial whirl rate theta' (rate of the polar angle of z)",
-           shows="whirl_rate"),
-    output("v_rel", "m/s", "Slip velocity at the contact point R Omega + c_r theta'",
-           shows="v_rel"),
+    output("whirl_rate", "rad/s", "Inertial whirl rate theta' (rate of the polar angle of z "
+                                  "seen from the race's centre)", shows="whirl_rate"),
+    output("v_rel", "m/s", "Slip velocity at the contact point R Omega + c_r theta' (with a "
+                           "real bearing: minus the race's surface speed)", shows="v_rel"),
     output("F_bx", "N", "Bearing (contact) force on the rotor x, step-averaged, impulses as "
                         "P/h"),
     output("F_by", "N", "Bearing (contact) force on the rotor y, step-averaged, impulses as "
                         "P/h"),
     output("F_n", "N", "Normal contact force, step-averaged", 0.0),
-    output("F_n_peak", "N", "Peak normal contact force within the step", 0.0),
+    output("F_n_peak", "N", "Peak normal contact force within the step: with "
+                            "contact_compliant the true peak; under the rigid law the larger "
+                            "of the sustained contact force's peak and P_n/h of the step's "
+                            "largest impact", 0.0),
     output("P_n", "N.s", "Normal contact impulse within the step", 0.0),
     output("T_f", "N.m", "Friction torque on the spin, step-averaged; < 0 brakes a positive "
                          "spin"),
@@ -91,7 +97,8 @@ TABLE: tuple[Var, ...] = (
            shows="t_last_impact"),
     output("v_last_impact", "m/s", "Normal speed rdot- of the last impact; 0 before any", 0.0,
            shows="v_last_impact"),
-    output("E_diss", "J", "Energy dissipated by contact, cumulative", 0.0, shows="E_diss"),
+    output("E_diss", "J", "Energy dissipated by contact (impacts, contact damping, friction), "
+                          "cumulative", 0.0, shows="E_diss"),
     output("Omega_out", "rad/s", "Spin speed at the end of the step: the spin state if "
                                  "integrate_spin, else the input Omega", shows="Omega"),
     output("mode", "", "Contact mode at the end of the step: 0 free, 1 sliding, 2 rolling",
@@ -102,9 +109,49 @@ TABLE: tuple[Var, ...] = (
            "Integer"),
     output("in_contact", "", "Rotor in sustained contact (mode != 0) at the end of the step",
            type_="Boolean"),
+    # the real touchdown bearing (docs/model.md §10); appended, so that the value
+    # references above stay as they were. Fixed; every option needs integrate_spin.
+    fixed("race_turns", "Boolean", False,
+          "The touchdown bearing's inner race turns (J_b, T_b0, c_bw, omega_b0)"),
+    limited("J_b", PARAMETER, 2e-4, "Polar inertia of the turning race, used if race_turns"),
+    limited("T_b0", PARAMETER, 0.02, "Race drag: constant (Coulomb) part, also the static "
+                                     "friction that holds it at rest; used if race_turns"),
+    limited("c_bw", PARAMETER, 1e-5, "Race drag: viscous part; used if race_turns"),
+    limited("omega_b0", PARAMETER, 0.0, "Initial spin of the race; used if race_turns"),
+    fixed("support_compliant", "Boolean", False,
+          "The race's centre sits on an isotropic spring-damper (m_b, k_b, c_b)"),
+    limited("m_b", PARAMETER, 2.0, "Mass of the race and housing on the support; used if "
+                                   "support_compliant"),
+    limited("k_b", PARAMETER, 5e7, "Support stiffness; used if support_compliant"),
+    limited("c_b", PARAMETER, 2e3, "Support damping; used if support_compliant"),
+    fixed("contact_compliant", "Boolean", False,
+          "Compliant contact N = K delta^p_c (1 + chi delta') with the restitution d exact "
+          "(d = 0 refused); else the rigid impact law"),
+    limited("k_c", PARAMETER, 1e9, "Contact stiffness at 10 um penetration; used if "
+                                   "contact_compliant"),
+    limited("p_c", PARAMETER, 1.0, "Contact law exponent: 1 (linear) or 1.5 (Hertz); used if "
+                                   "contact_compliant"),
+    output("omega_b", "rad/s", "Spin of the race at the end of the step (0 unless "
+                               "race_turns)"),
+    output("x_b", "m", "Race centre x, inertial (0 unless support_compliant)"),
+    output("y_b", "m", "Race centre y, inertial (0 unless support_compliant)"),
+    output("vx_b", "m/s", "Race centre velocity x (0 unless support_compliant)"),
+    output("vy_b", "m/s", "Race centre velocity y (0 unless support_compliant)"),
+    output("F_sx", "N", "Force the bearing's support passes to the frame x, step-averaged "
+                        "(with a rigid support the contact force on the race, impulses as "
+                        "P/h)"),
+    output("F_sy", "N", "Force the bearing's support passes to the frame y, step-averaged"),
+    output("P_fric", "W", "Friction power at the contact, step-averaged (impacts as their "
+                          "heat/h); 0 with all bearing options off", 0.0),
+    output("E_fric", "J", "Friction heat put into the bearing, cumulative; 0 with all "
+                          "bearing options off (E_diss then holds it)", 0.0),
+    output("E_drag", "J", "Heat of the race's drag, cumulative (0 unless race_turns)", 0.0),
 )
 
 BY_NAME = {v.name: v for v in TABLE}
+REAL_BEARING = tuple(v.name for v in TABLE[TABLE.index(BY_NAME["race_turns"]):])
+"""The rows of the real bearing (appended in FMU state version 3): a state of version 1 or
+2 lacks them, and they take their start values (all options off) when it is restored."""
 PARAMETERS = names(TABLE, PARAMETER)
 TUNABLE: frozenset[str] = frozenset(names(TABLE, PARAMETER, tunable=True))
 FIXED = names(TABLE, PARAMETER, tunable=False)

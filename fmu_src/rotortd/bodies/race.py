@@ -105,6 +105,8 @@ class RealRace:
         """Heat of the race's drag so far (J)."""
         self.E_support = 0.0
         """Heat of the support's damper so far (J)."""
+        self.E_fric = 0.0
+        """Friction heat put into the contact so far (J): sliding and impacts."""
         sup = bp.support_compliant
         self._sigma = 0.5 * bp.c_b / bp.m_b if sup else 0.0
         self._w2 = bp.k_b / bp.m_b if sup else 0.0
@@ -225,7 +227,8 @@ class RealRace:
         """The race's state as a plain dict (floats round-trip exactly)."""
         return {"kind": self.KIND, "x_b": self.z_b.real, "y_b": self.z_b.imag,
                 "vx_b": self.v_b.real, "vy_b": self.v_b.imag, "omega_b": self.omega_b,
-                "held": self.held, "E_drag": self.E_drag, "E_support": self.E_support}
+                "held": self.held, "E_drag": self.E_drag, "E_support": self.E_support,
+                "E_fric": self.E_fric}
 
     @classmethod
     def from_record(cls, bp: BearingParams, rec: dict[str, Any], *, c_r: float, R: float
@@ -235,4 +238,5 @@ class RealRace:
                    v_b=complex(rec["vx_b"], rec["vy_b"]), omega_b=float(rec["omega_b"]))
         race.held = bool(rec["held"])
         race.E_drag, race.E_support = float(rec["E_drag"]), float(rec["E_support"])
+        race.E_fric = float(rec["E_fric"])
         return race

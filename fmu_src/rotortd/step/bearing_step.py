@@ -69,6 +69,27 @@ class BearingSteps:
         """(z, v): the rotor's own state, in flight and in contact alike."""
         return self._z, self._v
 
+    def _bearing_output_values(self, Omega: float | None = None, amb_on: float | None = None
+                               ) -> tuple[float, ...]:
+        """``TouchdownCore.output_values`` once the race moves (docs/model.md §10, "What the
+        outputs mean"): x, y, vx, vy the rotor's centre in the frame; r_rel, U, dU/dt and
+        the whirl rate of Delta = z - z_b; v_rel the slip (10.5)."""
+        out = list(type(self).output_values(self, Omega, amb_on))
+        race, p = self._race, self._p
+        W = self._inputs[0] if Omega is None else Omega
+        D, dD = self._z - race.z_b, self._v - race.v_b
+        rot = self._phasor().conjugate()
+        U = D * rot / p.c_r
+        den = p.c_r * W
+        dU = (dD - 1j * W * D) * rot / den if den != 0.0 else 0j
+        r = abs(D)
+        whirl = (D.conjugate() * dD).imag / (r * r) if r > 0.0 else 0.0
+        n = D / r if r > 0.0 else 1.0 + 0j
+        out[4:9] = [r / p.c_r, U.real, U.imag, dU.real, dU.imag]
+        out[10] = whirl
+        out[11] = p.R * W + (n.conjugate() * dD).imag - race.surface_speed(n)
+        return tuple(out)
+
     def _bearing_quiet_step(self, h: float, F: complex, a: float, T_drive: float, cap: int
                             ) -> StepReport | None:
         """The quiet step of the fixed bearing (``SpinSteps._spin_quiet_step``) while the
@@ -157,7 +178,9 @@ class BearingSteps:
                                         r.stick, r.E_diss), n)
         if not self._law.support:  # a rigid support passes the impulse to the frame
             rep.P_support += complex(r.P_n, r.P_t) * n
-        rep.E_fric += 0.5 * r.P_t * (vrel + r.vrel_plus)
+        heat = 0.5 * r.P_t * (vrel + r.vrel_plus)  # the tangential impulse's work
+        rep.E_fric += heat
+        race.E_fric += heat
         return plastic
 
     def _bearing_apply_impulse(self, pair: ContactPair, r: SpinReset, n: complex,
@@ -256,6 +279,7 @@ class BearingSteps:
                                      peak=end.N_peak / mc, work=end.work), mc, p.c_r)
         rep.P_support += complex(q[8], q[9])
         rep.E_fric += q[4]
+        race.E_fric += q[4]
 
     def _bearing_transition(self, event: Event | None, st: StepContext) -> None:
         """The contact's next discrete state after ``event`` (None: the step's end)."""

@@ -67,6 +67,10 @@ class StepReport:
     E_fric: float = 0.0
     """Real bearing: friction heat put into the contact over the step (J), impacts' share
     included."""
+    F_support: complex = 0j
+    """Real bearing: P_support/h (N), the support's force on the frame, step-averaged."""
+    P_fric: float = 0.0
+    """Real bearing: E_fric/h (W), the friction power, step-averaged."""
 
     def add_impact(self, imp: Impact, n: complex) -> None:
         """Add an impact at the unit contact normal n (inertial): the impact itself, its

@@ -167,7 +167,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
     _BEARING_CHOICES = (("_advance_free", "_bearing_advance_free"),
                         ("_advance_contact", "_bearing_advance_contact"),
                         ("_wall_state", "_bearing_wall_state"),
-                        ("_spin_quiet_step", "_bearing_quiet_step"))
+                        ("_spin_quiet_step", "_bearing_quiet_step"),
+                        ("output_values", "_bearing_output_values"))
     """The choices bound in place of the fixed bearing's when a real bearing's option is on
     (after the spin state's)."""
 
@@ -214,9 +215,11 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         psi0: float = 0.0,
         t0: float = 0.0,
         J: float = INF,
+        bearing: BearingParams | None = None,
     ) -> TouchdownCore:
         """Start on the steady free whirl z = Z0 + Z1 e^{i psi} (the regular equilibrium U*)
-        of the held spin Omega (rad/s); with J finite the spin is a state starting there.
+        of the held spin Omega (rad/s); with J finite the spin is a state starting there
+        (``bearing``: a real bearing's options, its race at rest at the origin).
 
         Raises ParameterError when it does not exist (no stiffness, undamped resonance) or
         is not admissible (it leaves the clearance).
@@ -241,7 +244,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
                 f"|Z0| + |Z1| = {(abs(Z0) + abs(Z1)) / params.c_r:.6g} c_r; it must be < 1 c_r"
             )
         return cls(params, J=J, z0=Z0 + Z1, v0=1j * fm.Omega * Z1, psi0=psi0, Omega0=Omega,
-                   t0=t0)
+                   t0=t0, bearing=bearing)
 
     # ------------------------------------------------------------------ state access
 
@@ -519,6 +522,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         for imp in rep.impacts:
             rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
         rep.T_f = -self._p.R * rep.P_t * inv
+        if self._race is not None:
+            rep.F_support, rep.P_fric = rep.P_support * inv, rep.E_fric * inv
         if self.imbalance_torque:
             rep.T_imb = rep.P_imb * inv
         else:
@@ -679,19 +684,21 @@ class SpinCore(TouchdownCore):
 
     def __init__(self, params: RotorParams, J: float, *, z0: complex = 0j,
                  v0: complex = 0j, psi0: float = 0.0, Omega0: float = 0.0,
-                 t0: float = 0.0) -> None:
+                 t0: float = 0.0, bearing: BearingParams | None = None) -> None:
         check_range("J", J, 0.0, lo_open=True, unit="kg m^2")  # (finite: check_finite)
-        super().__init__(params, J=J, z0=z0, v0=v0, psi0=psi0, Omega0=Omega0, t0=t0)
+        super().__init__(params, J=J, z0=z0, v0=v0, psi0=psi0, Omega0=Omega0, t0=t0,
+                         bearing=bearing)
 
     @classmethod
     def on_steady_whirl(cls, params: RotorParams, Omega: float, *, F_ext: complex = 0j,
                         amb_on: float = 1.0, psi0: float = 0.0, t0: float = 0.0,
-                        J: float = INF) -> SpinCore:
+                        J: float = INF, bearing: BearingParams | None = None) -> SpinCore:
         """Start on the held-spin steady whirl at Omega (rad/s) with the spin a state
         (TouchdownCore.on_steady_whirl; J required)."""
         core = TouchdownCore.on_steady_whirl(params, Omega, F_ext=F_ext, amb_on=amb_on,
                                              psi0=psi0, t0=t0)
-        return cls(params, J, z0=core.z, v0=core.v, psi0=psi0, Omega0=Omega, t0=t0)
+        return cls(params, J, z0=core.z, v0=core.v, psi0=psi0, Omega0=Omega, t0=t0,
+                   bearing=bearing)
 
 
 def restore_core(st: dict | CoreState) -> TouchdownCore:
