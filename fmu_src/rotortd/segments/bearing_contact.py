@@ -58,6 +58,8 @@ from .roots import illinois
 from .spin_contact import H_FRACTION, RHS_WORK, ROOT_ITERS, RTOL, STEP_WORK, HeldInputs
 
 Vector = list[float]
+_R_SLIDE, _R_STICK, _CLAMPED, _C_SLIDE, _C_STICK = range(5)
+"""The contact's kinds in BearingModel (the rigid law's below _CLAMPED)."""
 NY = 11
 """State components: x, y, x', y', psi, Omega, x_b, y_b, x_b', y_b', omega_b."""
 NQ = 10
@@ -128,75 +130,103 @@ class BearingModel:
         self.h, self.law, self.cs = h, law, cs
         self.m, self.J, self.R, self.e_c, self.phi = p.m, h.J, p.R, p.e_c, p.phi
         self.c_r, self.mu, self.mg, self.T = p.c_r, p.mu, p.m * p.g, h.T_drive
-        self.F1 = h.a * p.bias_force + h.F_ext  # constant forces at the centre (N)
+        F1 = h.a * p.bias_force + h.F_ext  # constant forces at the centre (N)
+        self.F1x, self.F1y = F1.real, F1.imag
         self.ac, self.ak = h.a * p.c, h.a * p.k
+        self.im, self.iJ = 1.0 / p.m, 1.0 / h.J
         self.turning = law.turns and not cs.race_held
-        self.w_b = law.R_b * law.R_b / law.J_b if self.turning else 0.0
+        self.iJb = 1.0 / law.J_b if self.turning else 0.0
+        self.w_b = law.R_b * law.R_b * self.iJb
         self.i_mb = 1.0 / law.m_b if law.support else 0.0
-
-    def forces(self, y: Vector) -> BearingForces:
-        """The contact's forces and the derivative of y at y."""
-        law, cs = self.law, self.cs
-        m, J, R, e_c = self.m, self.J, self.R, self.e_c
-        z, v = complex(y[0], y[1]), complex(y[2], y[3])
-        Om = y[5]
-        zb, vb = complex(y[6], y[7]), complex(y[8], y[9])
-        wb = y[10]
-        D = z - zb
-        r = abs(D)
-        n = D / r
-        w = n.conjugate() * (v - vb)
-        dd, dth = w.real, w.imag / r
-        vrel = R * Om + w.imag - law.R_b * wb
-        E = cmath.exp(1j * (y[4] + self.phi))
-        Fa = self.F1 - self.ac * v - self.ak * z  # F_amb + F_ext (N)
-        dOm0 = (self.T + e_c * (Fa.conjugate() * E).imag) / J
-        zdd0 = (Fa - 1j * self.mg) / m + e_c * (Om * Om - 1j * dOm0) * E
-        zbdd0 = -(law.k_b * zb + law.c_b * vb) * self.i_mb if law.support else 0j
-        T_b = -law.T_b0 * cs.s_b - law.c_bw * wb if self.turning else 0.0
-        wbd0 = T_b / law.J_b if self.turning else 0.0
-        q = n.conjugate() * (zdd0 - zbdd0)
-        a_n = q.real + r * dth * dth
-        a_t = R * dOm0 + q.imag - dth * dd - law.R_b * wbd0
-        eb = n.conjugate() * E  # e^{i beta}
-        B, A = e_c * eb.imag, R - e_c * eb.real
-        Wnn = 1.0 / m + B * B / J + self.i_mb
-        Wnt = A * B / J
-        Wtt = 1.0 / m + A * A / J + self.i_mb + self.w_b
-        delta = r - self.c_r
-        N_law = N_el = math.nan
+        self.kb, self.cb = (law.k_b, law.c_b) if law.support else (0.0, 0.0)
+        self.Tb0 = law.T_b0 * cs.s_b if self.turning else 0.0
+        self.cbw = law.c_bw if self.turning else 0.0
         if law.compliant:
+            self.kind = _CLAMPED if cs.clamped else (_C_SLIDE if cs.s != 0.0 else _C_STICK)
+        else:
+            self.kind = _R_SLIDE if cs.s != 0.0 else _R_STICK
+        self.mus = self.mu * cs.s
+
+    def _eval(self, y: Vector) -> tuple[float, ...]:
+        """The one definition of the contact's mechanics at y (module docstring), in real
+        arithmetic: (N, F_t, delta, delta', v_rel, n_x, n_y, N_law, N_el, T_b, the relative
+        acceleration Delta'' (x, y), |Delta|, theta', then the eleven derivatives of y)."""
+        x, yy, vx, vy, psi, Om, xb, yb, vxb, vyb, wb = y[:11]
+        R, R_b, e_c = self.R, self.law.R_b, self.e_c
+        Dx, Dy = x - xb, yy - yb
+        r = math.hypot(Dx, Dy)
+        nx, ny = Dx / r, Dy / r
+        ux, uy = vx - vxb, vy - vyb
+        dd = nx * ux + ny * uy
+        wt = nx * uy - ny * ux
+        dth = wt / r
+        vrel = R * Om + wt - R_b * wb
+        ang = psi + self.phi
+        cE, sE = math.cos(ang), math.sin(ang)
+        Fx = self.F1x - self.ac * vx - self.ak * x  # F_amb + F_ext (N)
+        Fy = self.F1y - self.ac * vy - self.ak * yy
+        dOm0 = (self.T + e_c * (Fx * sE - Fy * cE)) * self.iJ
+        O2 = Om * Om
+        zx0 = Fx * self.im + e_c * (O2 * cE + dOm0 * sE)
+        zy0 = (Fy - self.mg) * self.im + e_c * (O2 * sE - dOm0 * cE)
+        bx0 = -(self.kb * xb + self.cb * vxb) * self.i_mb
+        by0 = -(self.kb * yb + self.cb * vyb) * self.i_mb
+        T_b = -self.Tb0 - self.cbw * wb
+        wbd0 = T_b * self.iJb
+        qx, qy = zx0 - bx0, zy0 - by0
+        a_n = nx * qx + ny * qy + r * dth * dth
+        a_t = R * dOm0 + nx * qy - ny * qx - dth * dd - R_b * wbd0
+        B = e_c * (nx * sE - ny * cE)  # e_c Im(e^{i beta}), e^{i beta} = conj(n) E
+        A = R - e_c * (nx * cE + ny * sE)
+        iJ, im, i_mb = self.iJ, self.im, self.i_mb
+        Wnn = im + B * B * iJ + i_mb
+        Wnt = A * B * iJ
+        Wtt = im + A * A * iJ + i_mb + self.w_b
+        delta = r - self.c_r
+        kind = self.kind
+        N_law = N_el = math.nan
+        if kind >= _CLAMPED:  # the compliant law
+            law = self.law
             N_el = law.K * delta ** law.p if delta > 0.0 else 0.0
-            N_law = N_el * (1.0 + cs.chi * dd)
-            N = 0.0 if cs.clamped else N_law
-            if cs.clamped:
-                Ft = 0.0
-            elif cs.s != 0.0:
-                Ft = self.mu * cs.s * N
+            N_law = N_el * (1.0 + self.cs.chi * dd)
+            if kind == _CLAMPED:
+                N = Ft = 0.0
+            elif kind == _C_SLIDE:
+                N = N_law
+                Ft = self.mus * N
             else:
+                N = N_law
                 Ft = (a_t - Wnt * N) / Wtt
-        elif cs.s != 0.0:
-            N = a_n / (Wnn + self.mu * cs.s * Wnt)
-            Ft = self.mu * cs.s * N
+        elif kind == _R_SLIDE:
+            N = a_n / (Wnn + self.mus * Wnt)
+            Ft = self.mus * N
         else:
             det = Wnn * Wtt - Wnt * Wnt
             N = (Wtt * a_n - Wnt * a_t) / det
             Ft = (Wnn * a_t - Wnt * a_n) / det
-        P = complex(N, Ft) * n  # the force on the race (N); the rotor's is -P
-        dOm = dOm0 - (B * N + A * Ft) / J
-        zdd = zdd0 - P / m - 1j * e_c * (dOm - dOm0) * E
-        zbdd = zbdd0 + P * self.i_mb if law.support else 0j
-        wbd = wbd0 + law.R_b * Ft / law.J_b if self.turning else 0.0
-        dy = [v.real, v.imag, zdd.real, zdd.imag, Om, dOm, vb.real, vb.imag, zbdd.real,
-              zbdd.imag, wbd]
+        Px, Py = N * nx - Ft * ny, N * ny + Ft * nx  # (N + i F_t) n: the force on the race
+        dOm = dOm0 - (B * N + A * Ft) * iJ
+        dW = e_c * (dOm - dOm0)
+        zx = zx0 - Px * im + dW * sE
+        zy = zy0 - Py * im - dW * cE
+        bx, by = bx0 + Px * i_mb, by0 + Py * i_mb
+        wbd = wbd0 + R_b * Ft * self.iJb
+        return (N, Ft, delta, dd, vrel, nx, ny, N_law, N_el, T_b, zx - bx, zy - by, r, dth,
+                vx, vy, zx, zy, Om, dOm, vxb, vyb, bx, by, wbd)
+
+    def forces(self, y: Vector) -> BearingForces:
+        """The contact's forces and the derivative of y at y."""
+        e = self._eval(y)
+        N, Ft, delta, dd, vrel, nx, ny, N_law, N_el, T_b, ax, ay, r, dth = e[:14]
         dN = math.nan
-        if law.compliant:
+        if self.kind >= _CLAMPED:
             dN = 0.0
-            if delta > 0.0 and not cs.clamped:
-                ddd = (n.conjugate() * (zdd - zbdd)).real + r * dth * dth  # delta''
-                dN = (law.p * N_el / delta * dd * (1.0 + cs.chi * dd)
-                      + N_el * cs.chi * ddd)
-        return BearingForces(N, Ft, delta, dd, vrel, n, N_law, N_el, T_b, dN, dy)
+            if delta > 0.0 and self.kind != _CLAMPED:
+                ddd = nx * ax + ny * ay + r * dth * dth  # delta''
+                chi = self.cs.chi
+                dN = self.law.p * N_el / delta * dd * (1.0 + chi * dd) + N_el * chi * ddd
+        return BearingForces(N, Ft, delta, dd, vrel, complex(nx, ny), N_law, N_el, T_b, dN,
+                             list(e[14:]))
 
     def free_normal_acceleration(self, y: Vector) -> float:
         """delta'' (m/s^2) at y without contact force: a_n of the module docstring."""
@@ -211,18 +241,17 @@ class BearingModel:
 
     def rhs(self, _u: float, y: Vector) -> Vector:
         """d/du of the state and of the quadratures (module docstring)."""
-        f = self.forces(y)
-        law = self.law
-        vb = complex(y[8], y[9])
-        if law.support:
-            Fs = law.k_b * complex(y[6], y[7]) + law.c_b * vb
-            E_sup = law.c_b * (vb.real * vb.real + vb.imag * vb.imag)
+        e = self._eval(y)
+        N, Ft, _, dd, vrel, nx, ny, _, N_el, T_b = e[:10]
+        if self.law.support:
+            Fsx = self.kb * y[6] + self.cb * y[8]
+            Fsy = self.kb * y[7] + self.cb * y[9]
+            E_sup = self.cb * (y[8] * y[8] + y[9] * y[9])
         else:
-            Fs, E_sup = complex(f.N, f.F_t) * f.n, 0.0
-        Fc = -complex(f.N, f.F_t) * f.n
-        damp = (f.N - f.N_el) * f.ddelta if law.compliant else 0.0
-        return [*f.dy, f.N, f.F_t, Fc.real, Fc.imag, f.F_t * f.vrel, damp, -f.T_b * y[10],
-                E_sup, Fs.real, Fs.imag]
+            Fsx, Fsy, E_sup = N * nx - Ft * ny, N * ny + Ft * nx, 0.0
+        damp = (N - N_el) * dd if self.kind >= _CLAMPED else 0.0
+        return [*e[14:], N, Ft, Ft * ny - N * nx, -N * ny - Ft * nx, Ft * vrel, damp,
+                -T_b * y[10], E_sup, Fsx, Fsy]
 
     def events(self, y: Vector, n_slack: float = 0.0) -> list[tuple[Event, float]]:
         """The event functions at y (module docstring), each positive while the segment
