@@ -178,13 +178,13 @@ def test_options_need_the_spin_as_a_state() -> None:
 
 def test_bad_bearing_parameters_are_refused_with_their_range() -> None:
     p = RotorParams()
-    with pytest.raises(ParameterError, match=r"d = 0 is refused under the compliant"):
+    with pytest.raises(CrossParameterError, match=r"d = 0 is refused under the compliant"):
         TouchdownCore(RotorParams(d=0.0), J=0.04,
                       bearing=BearingParams(contact_compliant=True))
     with pytest.raises(ParameterError,
                        match=r"k_b = 10000000000000.0 N/m is out of range.*1e\+11\] N/m"):
         TouchdownCore(p, J=0.04, bearing=BearingParams(support_compliant=True, k_b=1e13))
-    with pytest.raises(ParameterError, match=r"p_c = 1\.2"):
-        TouchdownCore(p, J=0.04, bearing=BearingParams(contact_compliant=True, p_c=1.2))
+    with pytest.raises(ParameterError, match=r"p_c = 1\.6 is out of range.*\[1, 1\.5\]"):
+        TouchdownCore(p, J=0.04, bearing=BearingParams(contact_compliant=True, p_c=1.6))
     with pytest.raises(ParameterError, match="J_b = nan"):
         TouchdownCore(p, J=0.04, bearing=BearingParams(race_turns=True, J_b=math.nan))

@@ -184,7 +184,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         omega, f_ext, amb, _t_drive = self._input_values()
         bearing = self._make_bearing(rotortd)
         if bearing is not None and not self.integrate_spin:
-            raise ModelError(
+            raise rotortd.CrossParameterError(
                 "race_turns, support_compliant and contact_compliant need integrate_spin = "
                 "true: the real bearing's race brakes or spins up the rotor, which a held "
                 "spin cannot show (docs/model.md §10)")
@@ -236,17 +236,14 @@ class RotorTouchdownAdapter(GuardedSlave):
 
     def _make_bearing(self, rotortd: Any) -> Any:
         """The real bearing's options (``rotortd.BearingParams``), None when all are off
-        (the chapter's fixed rigid bearing). A value the core refuses (p_c not 1 or 1.5,
-        d = 0 under the compliant law) is a ModelError naming it."""
+        (the chapter's fixed rigid bearing). d = 0 under the compliant law is refused as a
+        cross-parameter constraint (CrossParameterError, from ``BearingParams.check``)."""
         kwargs = {f.name: getattr(self, f.name) for f in fields(rotortd.BearingParams)}
         bp = rotortd.BearingParams(**{k: bool(v) if isinstance(v, bool) else float(v)
                                       for k, v in kwargs.items()})
         if not bp.any_option:
             return None
-        try:
-            bp.check(float(self.d))
-        except rotortd.ParameterError as exc:
-            raise ModelError(str(exc)) from exc
+        bp.check(float(self.d))  # (the ranges were checked with every parameter's)
         return bp
 
     def _fixed_values(self) -> dict[str, Any]:

@@ -129,7 +129,8 @@ TABLE: tuple[Var, ...] = (
           "(d = 0 refused); else the rigid impact law"),
     limited("k_c", PARAMETER, 1e9, "Contact stiffness at 10 um penetration; used if "
                                    "contact_compliant"),
-    limited("p_c", PARAMETER, 1.0, "Contact law exponent: 1 (linear) or 1.5 (Hertz); used if "
+    limited("p_c", PARAMETER, 1.0, "Contact law exponent: 1 linear, 10/9 line contact "
+                                   "(roller), 1.5 Hertz point contact (ball); used if "
                                    "contact_compliant"),
     output("omega_b", "rad/s", "Spin of the race at the end of the step (0 unless "
                                "race_turns)"),

@@ -24,7 +24,7 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any
 
-from ..limits import LIMITS, ParameterError
+from ..limits import LIMITS, CrossParameterError, ParameterError
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,7 +32,9 @@ class BearingParams:
     """The real bearing's options and parameters (SI; docs/model.md §10). ``race_turns``:
     J_b (kg m^2), T_b0 (N m), c_bw (N m s), omega_b0 (rad/s, the race's spin at the start);
     ``support_compliant``: m_b (kg), k_b (N/m), c_b (N s/m); ``contact_compliant``: k_c
-    (N/m, the stiffness at delta_ref = 10 um), p_c (1 or 1.5)."""
+    (N/m, the stiffness at delta_ref = 10 um), p_c (the exponent, in [1, 1.5]: 1 linear,
+    10/9 Palmgren's line contact of a roller, 1.5 Hertz's point contact of a ball; the law
+    and its exact restitution hold for any p, docs/model.md §10)."""
 
     race_turns: bool = False
     J_b: float = 2e-4
@@ -54,21 +56,19 @@ class BearingParams:
 
     def check(self, d: float) -> None:
         """Raise ParameterError naming the first value outside its range (``limits.LIMITS``),
-        or d = 0 under the compliant law."""
+        CrossParameterError for d = 0 under the compliant law."""
         for f in fields(self):
             v = getattr(self, f.name)
             lim = LIMITS.get(f.name)
             if lim is None or isinstance(v, bool):
                 continue
             if not (math.isfinite(v) and lim.lo <= v <= lim.hi):
+                u = "" if lim.unit == "1" else f" {lim.unit}"
                 raise ParameterError(
-                    f"{f.name} = {v!r} {lim.unit} is out of range: it must lie in "
-                    f"[{lim.lo:g}, {lim.hi:g}] {lim.unit}")
-        if self.p_c not in (1.0, 1.5):
-            raise ParameterError(f"p_c = {self.p_c!r} is not allowed: the compliant contact "
-                                 "law's exponent is 1 (linear) or 1.5 (Hertz)")
+                    f"{f.name} = {v!r}{u} is out of range: it must lie in "
+                    f"[{lim.lo:g}, {lim.hi:g}]{u}")
         if self.contact_compliant and d == 0.0:
-            raise ParameterError(
+            raise CrossParameterError(
                 "d = 0 is refused under the compliant contact law (contact_compliant): the "
                 "damping that gives an impact the restitution d (docs/model.md (10.7)) has no "
                 "finite value at d = 0; use d > 0")
