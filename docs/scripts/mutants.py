@@ -150,6 +150,9 @@ MUTANTS: tuple[Mutant, ...] = (
     M("RO2", "contact modes", "rolling proved endless from one phasor's amplitude only",
       "return self.C - abs(self.a1) - abs(self.a2) > 0.0",
       "return self.C - abs(self.a1) > 0.0", (CLAIMS,)),
+    M("RO3", "contact modes", "rolling exit search that ran out of advances claims its whole "
+      "span free of exits", "        return None, u  # f > 0 on [0, u]",
+      "        return None, x_max  # f > 0 on [0, u]", (CLAIMS,)),
     M("RU1", "contact modes", "linearised rub admitted at a 1e-10 error budget (1e-14)",
       "LINEAR_BUDGET = 1e-14", "LINEAR_BUDGET = 1e-10", ("tests/test_contact.py",)),
     M("RU2", "contact modes", "rub locked when the snap moves the state by 1e-10 (1e-14)",
