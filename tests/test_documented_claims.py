@@ -271,12 +271,12 @@ def test_rolling_with_two_phasors_ends_where_they_align(W: float, frac: float) -
 def test_long_rolling_step_runs_to_its_first_exit() -> None:
     """docs/model.md §5 and §7: a step of 0.2 s of rolling that provably ends only where the
     two phasors of Gn align (C - |a1| - |a2| < 0 by 0.4 % of C, default geometry, e_c =
-    0.02 m, mu = 10, Omega = 30 rad/s, from theta = 0.7) runs (the exit search took 200
-    advances for 0.077 s, about 10 per whirl turn, and used to stop the step as if at its
-    work bound, "208 > 1600000"): rolling lasts until the first zero of min(Gn, mu Gn -
-    |Gt|) (computed here from the model's equations), the step ends at 0.2 s within the
-    bound."""
-    p = BASE.replace(e_c=0.02, mu=10.0)
+    0.02 m, mu = 10, Omega = 30 rad/s, phi = 0, from theta = 0.7) runs (the exit search
+    takes 200 advances for some 0.08 s, about 10 per whirl turn, and used to stop the step
+    as if at its work bound, "208 > 1600000"; the search then goes on in the next
+    segment): rolling lasts until the first zero of min(Gn, mu Gn - |Gt|) (computed here
+    from the model's equations), 0.07 s in, the step ends at 0.2 s within the bound."""
+    p = BASE.replace(e_c=0.02, mu=10.0, phi=0.0)
     W, th0 = 30.0, 0.7
     dth = -p.R * W / p.c_r
     C = dth * dth - p.k / p.m
