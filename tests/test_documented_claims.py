@@ -267,6 +267,34 @@ def test_rolling_with_two_phasors_ends_where_they_align(W: float, frac: float) -
     assert min(_rolling_margin(p, F, W, th0, dth, t1 * j / n)[0] for j in range(n)) > 0.0
 
 
+
+def test_long_rolling_step_runs_to_its_first_exit() -> None:
+    """docs/model.md §5 and §7: a step of 0.2 s of rolling that provably ends only where the
+    two phasors of Gn align (C - |a1| - |a2| < 0 by 0.4 % of C, default geometry, e_c =
+    0.02 m, mu = 10, Omega = 30 rad/s, phi = 0, from theta = 0.7) runs (the exit search
+    takes 200 advances for some 0.08 s, about 10 per whirl turn, and used to stop the step
+    as if at its work bound, "208 > 1600000"; the search then goes on in the next
+    segment): rolling lasts until the first zero of min(Gn, mu Gn - |Gt|) (computed here
+    from the model's equations), 0.07 s in, the step ends at 0.2 s within the bound."""
+    p = BASE.replace(e_c=0.02, mu=10.0, phi=0.0)
+    W, th0 = 30.0, 0.7
+    dth = -p.R * W / p.c_r
+    C = dth * dth - p.k / p.m
+    eu = p.e_c * W * W / p.c_r
+    F = -(C - 0.5 * eu) * cmath.exp(1j * th0) * p.m * p.c_r
+    e = cmath.exp(1j * th0)
+    core = TouchdownCore(p, z0=p.c_r * e, v0=1j * p.c_r * dth * e)
+    rep = core.step(0.2, W, F, 1.0)
+    assert rep.status == 0 and rep.message == "", rep.message
+    assert core.t == 0.2 and rep.work <= 1_600_000, (core.t, rep.work)
+    assert rep.transitions[1][1] == "rolling" and rep.transitions[1][0] < 1e-15, rep.transitions
+    t1 = rep.transitions[2][0]
+    assert t1 > 0.05, rep.transitions  # past several whirl turns
+    f1, scale = _rolling_margin(p, F, W, th0, dth, t1)
+    assert abs(f1) <= 1e-12 * scale, f1 / scale
+    n = int(100 * t1 * (W - dth))
+    assert min(_rolling_margin(p, F, W, th0, dth, t1 * j / n)[0] for j in range(n)) > 0.0
+
 def test_no_mode_is_entered_and_left_at_one_instant() -> None:
     """docs/model.md §5 "Transitions": at zero slip, "sliding -> rolling" only when
     |Gt| <= mu Gn, else "sliding -> sliding (slip reversal)"; "Boundaries in rounding": the

@@ -163,6 +163,35 @@ def test_event_matches_mp(name: str) -> None:
     assert not bad, f"{name}: {bad}"
 
 
+
+# A slip start inside one integrator step (docs/model.md §8): rolling in dry whirl with the
+# bearing on and a drive torque, |F_t|/N rises to a shallow peak (0.009896 by the step's
+# Hermite midpoint) inside the accepted step 0.00063950 + 7.49e-5 s, at whose ends it is
+# below 0.009875 (and below that before). With mu = 0.00988 between the two, mu N - |F_t|
+# dips below 0 and back within that step (about 0.22 rad of beta wide): only the midpoint
+# check sees it. The step grid does not depend on mu here (rolling ignores mu, and the
+# quadratures' force scale is m c_r w^2 > (1 + mu) N), so the scene is that grid's.
+DIP = {**CHAPTER, "mu": 0.00988}
+DIP_CASE = (0, BOTTOM, 0.0, 0.6, W_WHIP, 3e-3, 1.0, 0j, 50.0)  # as CASES, t = 3 ms
+
+
+def test_slip_start_within_one_step_is_found_at_its_time() -> None:
+    """docs/model.md §8: the event functions are checked at every step's end and at its
+    midpoint, so a sign change is missed only if it starts and ends within half a step. A
+    slip start whose dip lies inside one step, around its midpoint, is the segment's end,
+    at the 20-digit reference's first zero of mu N - |F_t| (to 1e-12 of the duration, as
+    test_event_matches_mp), and the state there agrees as there."""
+    s, th, dth, psi, Om, t, a, F_ext, T_drive = DIP_CASE
+    held = HeldInputs(RotorParams(**DIP), J, a, F_ext, T_drive)
+    end = SpinContact(held, s, th, dth, psi, Om).run(t, 10**9)
+    ref = mp_contact(DIP, J, s, th, dth, psi, Om, t, a=a, F_ext=F_ext, T_drive=T_drive,
+                     event="slip_start", dps=20, per_rad=16)
+    assert ref["event"] == "slip_start" and float(ref["t"]) < 1e-3
+    assert end.event == "slip_start", (end.event, end.duration, float(ref["t"]))
+    assert abs(end.duration - ref["t"]) <= TOL * ref["t"], (end.duration, float(ref["t"]))
+    for key in ("theta", "psi", "Omega"):
+        assert abs(getattr(end, key) - ref[key]) <= TOL * max(1.0, abs(ref[key])), key
+
 if __name__ == "__main__":
     for nm in CASES:
         e = errors(core_segment(nm), mp_segment(nm))

@@ -173,3 +173,21 @@ def test_tiny_spin_speed_behaves_like_zero(W: float) -> None:
         rep = spin.step(1e-3 if i % 2 else 3.7e-3, F_ext=0j, amb_on=1.0, T_drive=0.0)
         assert rep.status == STATUS_OK and math.isfinite(spin.Omega)
     assert spin.n_impacts > 0
+
+
+def test_a_stop_below_the_bound_does_not_claim_it() -> None:
+    """A segment that stops for another reason than the work bound (the spin-state flight
+    without an a-priori bound of its motion raises ContactWorkExceeded with work = 0) gets
+    a message that says how much of the bound was used, never "work bound reached: 208 >
+    1600000" (the rolling exit search once stopped a step so)."""
+    from rotortd.contact.wall import ContactWorkExceeded
+    from rotortd.step.report import StepContext, StepReport, stop_at_work_bound
+
+    for used, claim in ((200, False), (WORK_MAX + 1, True)):
+        rep, st = StepReport(), StepContext(WORK_MAX)
+        st.work.iters = used
+        stop_at_work_bound(rep, st, ContactWorkExceeded("no a-priori bound", 0), 0.5, 0.1,
+                           0.2, "free flight")
+        assert rep.status == STATUS_WORK_CAP
+        assert rep.message.startswith("work bound reached") == claim, rep.message
+        assert f"{used}" in rep.message and "no a-priori bound" in rep.message, rep.message

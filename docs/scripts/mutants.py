@@ -150,17 +150,16 @@ MUTANTS: tuple[Mutant, ...] = (
     M("RO2", "contact modes", "rolling proved endless from one phasor's amplitude only",
       "return self.C - abs(self.a1) - abs(self.a2) > 0.0",
       "return self.C - abs(self.a1) > 0.0", (CLAIMS,)),
+    M("RO3", "contact modes", "rolling exit search that ran out of advances claims its whole "
+      "span free of exits", "        return None, u  # f > 0 on [0, u]",
+      "        return None, x_max  # f > 0 on [0, u]", (CLAIMS,)),
     M("RU1", "contact modes", "linearised rub admitted at a 1e-10 error budget (1e-14)",
       "LINEAR_BUDGET = 1e-14", "LINEAR_BUDGET = 1e-10", ("tests/test_contact.py",)),
     M("RU2", "contact modes", "rub locked when the snap moves the state by 1e-10 (1e-14)",
       "LOCK_TOL = 1e-14", "LOCK_TOL = 1e-10", ("tests/test_contact.py",)),
     M("SC1", "spin-state contact", "spin-state contact: the midpoint check of the event "
       "functions dropped", "        if self._margin(mid) <= 0.0:\n",
-      "        if False:\n", ("tests/test_spin_contact_mp.py",),
-      note="OPEN, not killed and not shown equivalent: the check only matters for an "
-      "event function that dips below 0 and back within one integrator step (at most 1 "
-      "rad) around its midpoint; 2,700 random spin-state contact segments (300 built to "
-      "graze N = 0) gave the same events and durations to the bit with and without it"),
+      "        if False:\n", ("tests/test_spin_contact_mp.py",)),
     # ---------------------------------------------------------------- low-speed rule
     M("L1", "low-speed rule", "chattering threshold ETA_HEIGHT tenfold",
       "ETA_HEIGHT = 1e-14", "ETA_HEIGHT = 1e-13", ("tests/test_contact.py",)),

@@ -10,7 +10,8 @@ code). SI units, inertial frame, complex positions.
   ``~ 4^-order``, far below ``10^-dps``. Returns ``(z, v, psi, Omega)`` at ``t``.
 * :func:`mp_contact`: one sustained-contact segment (sliding with slip sign s, or rolling) from
   docs/model.md §8, with the impulses int N, int F_t, int F_c and the friction dissipation
-  int mu N |v_rel|, optionally stopped at the first zero of v_rel (slip zero) or N (lift-off):
+  int mu N |v_rel|, optionally stopped at the first zero of v_rel (slip zero), N (lift-off)
+  or mu N - |F_t| (slip start, rolling):
   Taylor series by automatic differentiation (exponentials, products and the 2x2 / 3x3 solve
   as series recurrences), order dps + 10, steps of at most 1/(8 w); 40 and 50 digits (12 steps
   per radian) agree to 1e-50 (``tests/test_spin_contact_mp.py``).
@@ -328,12 +329,14 @@ def mp_contact(params: dict[str, Any], J: float, s: int, theta0: float, dtheta0:
                T_drive: float = 0.0, event: str | None = None, dps: int = 40,
                order: int | None = None, per_rad: int = 8) -> dict[str, Num]:
     """One contact segment (docs/model.md §8) from t = 0 to t [s], or to the first zero of the
-    event function (``event``: "slip_zero" for v_rel, sliding only; "lift_off" for N) if
-    that comes first; sliding with slip sign s = +-1, rolling with s = 0 (theta' =
-    -R Omega/c_r, ``dtheta0`` ignored). Taylor method of order ``order`` (default
-    dps + 10) with equal steps of at most 1/(per_rad w), w the largest rate (|theta'|,
-    |Omega|, |Omega - theta'|, sqrt(|N|/(m c_r)), sqrt(k/m), c/m, 1 /s). The event's zero is
-    the root of its step's polynomial (mpmath.findroot, anderson, then Newton polish).
+    event function (``event``: "slip_zero" for v_rel, sliding only; "lift_off" for N;
+    "slip_start" for mu N - |F_t|, rolling only, F_t keeping its sign within a step) if
+    that comes first (seen at the ends of its steps); sliding with slip sign s = +-1,
+    rolling with s = 0 (theta' = -R Omega/c_r, ``dtheta0`` ignored). Taylor method of order
+    ``order`` (default dps + 10) with equal steps of at most 1/(per_rad w), w the largest
+    rate (|theta'|, |Omega|, |Omega - theta'|, sqrt(|N|/(m c_r)), sqrt(k/m), c/m, 1 /s). The
+    event's zero is the root of its step's polynomial (mpmath.findroot, anderson, then
+    Newton polish).
 
     Returns mpmath numbers: t (end time, s), theta, dtheta, psi, Omega, P_n = int N,
     P_t = int F_t (N s), P_c = int F_c (complex N s), E_diss = int mu N |v_rel| (J),
@@ -360,7 +363,11 @@ def mp_contact(params: dict[str, Any], J: float, s: int, theta0: float, dtheta0:
             ser = _contact_series(par, s, th, dth, psi, om, nord)
             tau = h
             if event is not None:
-                f = ser["v_rel"] if event == "slip_zero" else ser["N"]
+                if event == "slip_start":  # mu N - |F_t| (rolling), F_t of one sign near it
+                    sig = 1 if ser["F_t"][0] >= 0 else -1
+                    f = [par["mu"] * a - sig * b for a, b in zip(ser["N"], ser["F_t"])]
+                else:
+                    f = ser["v_rel"] if event == "slip_zero" else ser["N"]
                 sgn = (s if event == "slip_zero" else 1)
                 if sgn * _poly(f, h) <= 0:
                     root = mpmath.findroot(lambda x, f=f: _poly(f, x), (0, h),

@@ -13,12 +13,15 @@ from dataclasses import dataclass
 
 from ..contact.events import Event
 from ..contact.search import WORK_MAX
-from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces, phase_integral
+from ..contact.wall import ContactTally, SegmentEnd, WallForces, phase_integral
 from ..scaled import wrap_angle
 
 MAX_ROOT_ITERS = 200
-"""Cap on conservative-advancement iterations for one rolling exit search."""
-
+"""Most conservative-advancement iterations of one exit function in one rolling segment.
+An advance is at most about 2/nu of the fastest phasor's rate nu (a few per whirl turn), so
+200 cover some 30 whirl turns; a segment whose search has not reached the end of its span
+by then ends there, without event, and the step loop starts the next one (a long step of
+steady rolling is taken in segments, each checked against the step's work bound)."""
 
 
 @dataclass(frozen=True)
@@ -41,14 +44,16 @@ class TrigSum:
         """True when f > 0 for all u (proved by the amplitude bound)."""
         return self.C - abs(self.a1) - abs(self.a2) > 0.0
 
-    def first_zero(self, x_max: float, tally: ContactTally) -> float | None:
-        """First u in (0, x_max] where f reaches 0 (f(0) > 0 assumed), or None.
+    def first_zero(self, x_max: float, tally: ContactTally) -> tuple[float | None, float]:
+        """(u, x_max'): the first u in (0, x_max] where f reaches 0 (f(0) > 0 assumed), or
+        None if there is none in (0, x_max'], x_max' <= x_max the span searched: x_max, or
+        less when MAX_ROOT_ITERS advances ran out before it (f > 0 proved on [0, x_max']).
 
         Conservative advancement with f(u + x) >= f + f' x - M x^2/2,
         M = |a1| nu1^2 + |a2| nu2^2 >= |f''|.
         """
         if self.never_zero():
-            return None
+            return None, x_max
         M = abs(self.a1) * self.nu1**2 + abs(self.a2) * self.nu2**2
         tol = 1e-15 * (abs(self.C) + abs(self.a1) + abs(self.a2))
         u = 0.0
@@ -56,22 +61,20 @@ class TrigSum:
         if f0 <= tol and df0 > 0.0 and M > 0.0:  # on the boundary, moving inside: step off
             u = min(df0 / M, x_max)
             if self.value(u)[0] <= tol:
-                return 0.0
+                return 0.0, x_max
         for _ in range(MAX_ROOT_ITERS):
             tally.work += 1
             f, df = self.value(u)
             if f <= tol:
-                return u
+                return u, x_max
             if M == 0.0:
                 x = -f / df if df < 0.0 else math.inf
             else:
                 x = (df + math.sqrt(df * df + 2.0 * M * f)) / M
             if u + x >= x_max:
-                return None
+                return None, x_max
             u += x
-        raise ContactWorkExceeded(
-            f"rolling exit search exceeded {MAX_ROOT_ITERS} iterations", tally.work
-        )
+        return None, u  # f > 0 on [0, u]: the segment may last that long
 
 
 class Rolling:
@@ -113,8 +116,10 @@ class Rolling:
         return self.C + X.real, self.Gt0 + X.imag
 
     def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
-        """Roll up to ``rem`` seconds or until the first exit (lift-off or friction cone);
-        its work is bounded by MAX_ROOT_ITERS per exit, whatever ``limit``."""
+        """Roll up to ``rem`` seconds or until the first exit (lift-off or friction cone),
+        or less, without event, as far as MAX_ROOT_ITERS advances per exit function proved
+        none (the step loop goes on with the next segment); its work is bounded by that,
+        whatever ``limit``."""
         cone_slack = self.cone_slack
         tally = ContactTally()
         names = (Event.LIFT_OFF, Event.SLIP_START, Event.SLIP_START)
@@ -129,9 +134,11 @@ class Rolling:
         x_end, kind = rem, None
         for fn, name, shift in zip(self.exits(), names, shifts):
             fn = TrigSum(fn.C + shift, fn.a1, fn.a2, fn.nu1, fn.nu2)
-            x = fn.first_zero(x_end, tally)
+            x, searched = fn.first_zero(x_end, tally)
             if x is not None and x < x_end:
                 x_end, kind = x, name
+            elif searched < x_end:  # no exit up to where the search got: end there
+                x_end, kind = searched, None
         self._integrate(tally, x_end)
         theta = wrap_angle(self.theta0 + self.dtheta * x_end)
         return SegmentEnd(x_end, theta, self.dtheta, kind, tally, work=tally.work)

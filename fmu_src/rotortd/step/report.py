@@ -176,6 +176,10 @@ def stop_at_work_bound(rep: StepReport, st: StepContext, exc: Exception, t0: flo
     ``where`` names the segment). The exception's own work joins the step's count."""
     work = st.work
     work.iters += getattr(exc, "work", 0)
+    # a segment that stops for another reason (no a-priori bound of a flight) says so: the
+    # message claims the bound only when the step's count passed it
+    why = (f"work bound reached: {work.total} > {st.cap} work units" if work.total > st.cap
+           else f"stopped after {work.total} of {st.cap} work units")
     rep.status, rep.message = STATUS_WORK_CAP, (
-        f"work bound reached: {work.total} > {st.cap} work units; the core stopped at "
-        f"t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, in {where}: {exc}")
+        f"{why}; the core stopped at t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, "
+        f"in {where}: {exc}")
