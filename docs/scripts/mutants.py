@@ -192,9 +192,10 @@ MUTANTS: tuple[Mutant, ...] = (
       "        t = self._t + y\n        self._t_lo = (t - self._t) - y\n",
       "        t = self._t + y + 1e-13\n        self._t_lo = (t - self._t) - y\n",
       ("tests/test_core_state.py",)),
-    M("P1", "report", "F_n_peak sums the step's impacts instead of taking the largest "
-      "(issue 27)", "rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)",
-      "rep.F_n_peak = rep.F_n_peak + imp.P_n * inv", (CLAIMS,)),
+    M("P1", "report", "F_n_peak sums the step's contact segments' peaks instead of taking "
+      "the largest (issue 27; issue 24 made impulses leave it)",
+      "self.F_n_peak = max(self.F_n_peak, mc * tal.peak)",
+      "self.F_n_peak = self.F_n_peak + mc * tal.peak", (CLAIMS,)),
     # ---------------------------------------------------------------- work bound
     M("W1", "work bound", "WORK_MAX tenfold", "WORK_MAX = 1_600_000", "WORK_MAX = 16_000_000",
       (CLAIMS,)),

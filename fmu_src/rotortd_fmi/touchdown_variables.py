@@ -80,9 +80,9 @@ TABLE: tuple[Var, ...] = (
                         "P/h"),
     output("F_n", "N", "Normal contact force, step-averaged", 0.0),
     output("F_n_peak", "N", "Peak normal contact force within the step: with "
-                            "contact_compliant the true peak; under the rigid law the larger "
-                            "of the sustained contact force's peak and P_n/h of the step's "
-                            "largest impact", 0.0),
+                            "contact_compliant the true peak of N; under the rigid law the "
+                            "peak of the sustained contact force, impacts going to P_n (0 in "
+                            "a step of flight and impacts only)", 0.0),
     output("P_n", "N.s", "Normal contact impulse within the step", 0.0),
     output("T_f", "N.m", "Friction torque on the spin, step-averaged; < 0 brakes a positive "
                          "spin"),

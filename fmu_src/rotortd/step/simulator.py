@@ -519,8 +519,6 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         inv = 1.0 / h if h > 0.0 else 0.0
         rep.F_contact = rep.P_contact * inv
         rep.F_n = rep.P_n * inv
-        for imp in rep.impacts:
-            rep.F_n_peak = max(rep.F_n_peak, imp.P_n * inv)
         rep.T_f = -self._p.R * rep.P_t * inv
         if self._race is not None:
             rep.F_support, rep.P_fric = rep.P_support * inv, rep.E_fric * inv
