@@ -120,7 +120,7 @@ def _energy(core: TouchdownCore) -> float:
     """Mechanical energy (J) of rotor and race with the AMB off (docs/model.md §10)."""
     p, race = core.params, core.race
     assert race is not None
-    bp = race.params
+    bp = race.bp
     E = cmath.exp(1j * (core.psi + p.phi))
     vG = core.v + 1j * core.Omega * p.e_c * E
     zG = core.z + p.e_c * E
@@ -178,7 +178,7 @@ def test_options_need_the_spin_as_a_state() -> None:
 
 def test_bad_bearing_parameters_are_refused_with_their_range() -> None:
     p = RotorParams()
-    with pytest.raises(CrossParameterError, match=r"d = 0 is refused under the compliant"):
+    with pytest.raises(CrossParameterError, match=r"d = 0.0 is refused under the compliant"):
         TouchdownCore(RotorParams(d=0.0), J=0.04,
                       bearing=BearingParams(contact_compliant=True))
     with pytest.raises(ParameterError,

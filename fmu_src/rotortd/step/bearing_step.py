@@ -171,7 +171,7 @@ class BearingSteps:
             reference_rate(wf, dth, A, p.c_r), race.rate))
         if plastic:  # again from before the impact, with d = 0
             self._v = v_minus
-            race.set_motion(*before)
+            race.set_state(*before)
             r = pair.impact(dl, p.mu, 0.0, rdot, vrel)
             self._bearing_apply_impulse(pair, r, n, W)
         self._record_impact(rep, Impact(t, self._z, v_minus, self._v, rdot, r.P_n, r.P_t,
@@ -270,7 +270,7 @@ class BearingSteps:
         self._set_psi(y[4])
         self._set_spin(y[5])
         race = self._race
-        race.set_motion(complex(y[6], y[7]), complex(y[8], y[9]), y[10])
+        race.set_state(complex(y[6], y[7]), complex(y[8], y[9]), y[10])
         race.E_drag += q[6]
         race.E_support += q[7]
         mc = p.m * p.c_r
@@ -290,7 +290,7 @@ class BearingSteps:
             self._bearing_lift_off()
             return
         if event == Event.RACE_STOP:
-            self._race.set_motion(self._race.z_b, self._race.v_b, 0.0)
+            self._race.set_state(self._race.z_b, self._race.v_b, 0.0)
         clamped = {Event.LIFT_OFF: True, Event.CLAMP_END: False}.get(event, cs.clamped)
         if event == Event.SLIP_ZERO:
             self._v_rel_zero()
@@ -323,7 +323,7 @@ class BearingSteps:
 
     def _bearing_law(self) -> BearingLaw:
         """The segment's view of the bearing's parameters (SI)."""
-        bp, p = self._race.params, self._p
+        bp, p = self._race.bp, self._p
         return BearingLaw(bp.race_turns, bp.J_b, bp.T_b0, bp.c_bw, p.R + p.c_r,
                           bp.support_compliant, bp.m_b, bp.k_b, bp.c_b,
                           bp.contact_compliant, stiffness_coefficient(bp.k_c, bp.p_c),
@@ -331,7 +331,7 @@ class BearingSteps:
 
     def _bearing_c_d(self) -> float:
         """c_d of (10.7) for the restitution d under the compliant law (else 0)."""
-        return restitution_damping(self._p.d) if self._race.params.contact_compliant else 0.0
+        return restitution_damping(self._p.d) if self._race.bp.contact_compliant else 0.0
 
     # ------------------------------------------------------------------ state record
 
@@ -340,7 +340,7 @@ class BearingSteps:
         bearing's parameters and the contact's discrete state."""
         cs = self._cstate
         return {**self._race.record(), "kind": RealRace.KIND,
-                "params": asdict(self._race.params),
+                "params": asdict(self._race.bp),
                 "contact": {"s": cs.s, "clamped": cs.clamped, "chi": cs.chi,
                             "s_b": cs.s_b}}
 
