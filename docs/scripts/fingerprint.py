@@ -1343,6 +1343,11 @@ def rename(path: str, names: dict[str, str | None]) -> str | None:
     return path
 
 
+IGNORED: set[str] = set()
+"""Recorded columns left out of the comparison (``--ignore``): a column whose meaning a
+change redefines on purpose (issue 24: F_n_peak no longer folds in the impacts' P/h)."""
+
+
 def compare_final(v: Verdict, a: Any, b: Any, units: dict[str, float], what: str,
                   names: dict[str, str | None]) -> None:
     """Final state or counters, leaf by leaf through ``names`` (base -> head), floats
@@ -1356,6 +1361,8 @@ def compare_final(v: Verdict, a: Any, b: Any, units: dict[str, float], what: str
         if new is None:
             continue
         seen.add(new)
+        if key.split(".")[-1] in IGNORED:  # (an FMU's output variable of that name)
+            continue
         x, y = fa[key], fb.get(new, "<absent>")
         if x == y or (x is None and y == "<absent>" and key.split(".")[-1] in NULL_WHEN_HELD):
             continue
@@ -1380,7 +1387,8 @@ def _covered(head_path: str, names: dict[str, str | None]) -> bool:
 
 def compare_job(job: tuple[str, str, str], ra: dict[str, Any], rb: dict[str, Any],
                 wa: Path, wb: Path, spec: Spec) -> Verdict:
-    """Compare the recordings of one job in base (a) and head (b)."""
+    """Compare the recordings of one job in base (a) and head (b), every column but the
+    ``IGNORED`` ones."""
     v = Verdict(job)
     v.tags = ra.get("tags", {})
     v.summary = (ra.get("summary", {}), rb.get("summary", {}))
@@ -1407,12 +1415,15 @@ def compare_job(job: tuple[str, str, str], ra: dict[str, Any], rb: dict[str, Any
             v.max_scaled = math.inf
             continue
         added |= set(cb) - set(ca)  # a new output: compared on the base's columns
-        tb = load_table(wb, name, ext, len(cb))[:, [list(cb).index(c) for c in ca]]
-        compare_tables(v, load_table(wa, name, ext, len(ca)), tb, list(ca), units, label)
+        keep = [c for c in ca if c not in IGNORED]
+        tb = load_table(wb, name, ext, len(cb))[:, [list(cb).index(c) for c in keep]]
+        ta = load_table(wa, name, ext, len(ca))[:, [list(ca).index(c) for c in keep]]
+        compare_tables(v, ta, tb, keep, units, label)
     v.added = sorted(added)
-    if added and not v.first:  # identical on everything the base recorded
+    if (added or IGNORED) and not v.first:  # identical on everything compared
         v.identical = True
-        v.first = f"adds {', '.join(v.added)}"
+        v.first = ", ".join(([f"adds {', '.join(v.added)}"] if added else [])
+                            + ([f"ignores {', '.join(sorted(IGNORED))}"] if IGNORED else []))
     return v
 
 
@@ -1529,6 +1540,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     amp.add_argument("--no-amplification", action="store_true",
                      help="measure no amplification")
     ap.add_argument("--only", help="regular expression: scenes whose name matches")
+    ap.add_argument("--ignore", default="",
+                    help="comma-separated recorded columns to leave out of the comparison "
+                         "(e.g. F_n_peak, redefined by issue 24)")
     ap.add_argument("--no-fmu", action="store_true", help="core only")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
     ap.add_argument("--check-scenes", action="store_true",
@@ -1549,6 +1563,7 @@ def amp_jobs(verdicts: list[Verdict], jobs: list[tuple[str, str, str]],
 
 
 def run(args: argparse.Namespace, tmp: Path) -> int:
+    IGNORED.update(c for c in args.ignore.split(",") if c)
     specs = all_specs(ROOT, args.only)
     jobs = jobs_of(specs, not args.no_fmu)
     by_name = {s["name"]: s for s in specs}
