@@ -17,7 +17,9 @@ scatters by 1.7x on this kind of machine; a step is also abandoned after 4x the 
 wall time), non-finite outputs of an OK step, refusals of
 declared-valid input (an initialisation or step refusal whose message says neither
 "cross-parameter" nor, for a Discard, "work bound"/"work cap"), positions with
-|(x, y)| > c_r (1 + 1e-12) after an OK step, and state round trips that do not replay bit
+|(x, y) - (x_b, y_b)| > c_r (1 + 1e-12) after an OK step (measured from the race's centre;
+not under the compliant contact law, whose contact penetrates), and state round trips that
+do not replay bit
 for bit. Writes docs/fuzz_results.json and the generated block of docs/fuzz.md.
 """
 

@@ -67,6 +67,7 @@ STEP_WORK = 2 * SPIN_STEP_WORK
 """Work units per extrapolated step beyond its right-hand sides (as RHS_WORK)."""
 _R_SLIDE, _R_STICK, _CLAMPED, _C_SLIDE, _C_STICK = range(5)
 """The contact's kinds in BearingModel (the rigid law's below _CLAMPED)."""
+_NAN25 = (math.nan,) * 25
 NY = 11
 """State components: x, y, x', y', psi, Omega, x_b, y_b, x_b', y_b', omega_b."""
 NQ = 10
@@ -157,7 +158,16 @@ class BearingModel:
     def _eval(self, y: Vector) -> tuple[float, ...]:
         """The one definition of the contact's mechanics at y (module docstring), in real
         arithmetic: (N, F_t, delta, delta', v_rel, n_x, n_y, N_law, N_el, T_b, the relative
-        acceleration Delta'' (x, y), |Delta|, theta', then the eleven derivatives of y)."""
+        acceleration Delta'' (x, y), |Delta|, theta', then the eleven derivatives of y).
+        NaN everywhere where a trial state overflowed (an angle or a power out of range):
+        the integrator then rejects the step."""
+        try:
+            return self._mechanics(y)
+        except (ValueError, OverflowError, ZeroDivisionError):
+            return _NAN25
+
+    def _mechanics(self, y: Vector) -> tuple[float, ...]:
+        """``_eval`` without its guard."""
         x, yy, vx, vy, psi, Om, xb, yb, vxb, vyb, wb = y[:11]
         R, R_b, e_c = self.R, self.law.R_b, self.e_c
         Dx, Dy = x - xb, yy - yb
