@@ -395,6 +395,24 @@ def test_engines_apply_the_scene_parameters_quietly(systems: Path, engine: str) 
     assert np.all((rate > 40.0) & (rate < 47.0)), rate
 
 
+# ---------------------------------------------------------------------------- the real bearing
+@pytest.mark.parametrize("engine", ["fmpy", "libcosim"])
+def test_drop_onto_the_real_bearing_under_the_drivetrain(systems: Path, engine: str) -> None:
+    """drop_bearing (docs/model.md §10, docs/bearing.md): the drop scene with the turning
+    race on its sprung support and the compliant contact, under the PI drive, to 20 ms after
+    the failure at 0.1 s. The race is spun up by friction (omega_b > 150 rad/s, from 0),
+    the rotor keeps its speed (Omega > 182 rad/s, the drive's set point 184.2), a compliant
+    contact has no impulses (n_impacts 0) and its peak load is a force (1-20 kN; the
+    independent reference's first 20 ms of the bearing alone peak at 3.16 kN)."""
+    res = run_engine(systems, engine, "drop_bearing", stop=0.12)
+    _check_reached(res, 0.12, 1e-4)
+    assert res["RotorTouchdown.omega_b"][-1] > 150.0
+    assert res["RotorTouchdown.omega_b"][round(0.1 / 1e-4) - 1] == 0.0  # at rest before
+    assert res[OMEGA].min() > 182.0 and res["Drivetrain.Omega"][-1] > 182.0
+    assert res["RotorTouchdown.n_impacts"][-1] == 0
+    assert 1e3 < res["RotorTouchdown.F_n_peak"].max() < 2e4
+
+
 # ---------------------------------------------------------------------------- scene 2: rundown
 @pytest.mark.parametrize("engine", ["fmpy", "libcosim"])
 def test_rundown_impacts_then_rub(systems: Path, engine: str) -> None:

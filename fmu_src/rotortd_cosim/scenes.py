@@ -64,7 +64,20 @@ FORCE = Scene(
     events={"t_force_on": 0.03, "t_force_off": 0.1, "F_y_step": -1500.0},
 )
 
-SCENES: dict[str, Scene] = {s.name: s for s in (DROP, RUNDOWN, FORCE)}
+REAL_BEARING = {"mu": 0.15, "d": 0.9,
+                "race_turns": True, "J_b": 2e-4, "T_b0": 0.02, "c_bw": 1e-5, "omega_b0": 0.0,
+                "support_compliant": True, "m_b": 2.0, "k_b": 5e7, "c_b": 2e3,
+                "contact_compliant": True, "k_c": 1e9, "p_c": 1.0}
+"""The real touchdown bearing of issue 24 (docs/model.md §10, docs/bearing.md): a turning
+race on a sprung support with a compliant contact."""
+
+DROP_BEARING = Scene(
+    name="drop_bearing", title="Drop test onto the real bearing (turning race, sprung "
+    "support, compliant contact) under the PI drive", stop_time=0.35, step=1e-4,
+    rotor={**DROP.rotor, **REAL_BEARING}, drive=DROP.drive, events=DROP.events,
+)
+
+SCENES: dict[str, Scene] = {s.name: s for s in (DROP, RUNDOWN, FORCE, DROP_BEARING)}
 
 DROP_TORQUE = Scene(
     name="drop_torque", title="Drop test with a constant drive torque (no PI, no drag)",
@@ -99,6 +112,7 @@ RECORDED: tuple[tuple[str, str], ...] = (
     ("RotorTouchdown", "t_last_impact"), ("RotorTouchdown", "v_last_impact"),
     ("RotorTouchdown", "Omega_out"), ("RotorTouchdown", "psi"),
     ("RotorTouchdown", "E_diss"), ("RotorTouchdown", "F_amb_x"), ("RotorTouchdown", "F_amb_y"),
+    ("RotorTouchdown", "F_n_peak"), ("RotorTouchdown", "omega_b"),
     ("TouchdownEvents", "amb_on"), ("TouchdownEvents", "F_x"), ("TouchdownEvents", "F_y"),
 )
 
