@@ -23,6 +23,11 @@
    in the same FMU2Slave loop (every output read every step), with the inputs held and
    with T_drive set before every step by a PI drive on Omega_out (QUIET_PI); the issue's
    goal is a ratio of at most 1.5 (``--quiet-only`` counts only these).
+4. Timed (``--bearing``): the drop onto the real bearing of issue 24 (the options of
+   docs/model.md §10 on: the race turns, the support gives, the contact is compliant with
+   k_c = 1e9 N/m; mu = 0.15, d = 0.9), 3000 steps of 1e-4 s through simulate_fmu, against
+   the floor FMU (issue 24's target: at most 10x), and the FMU's CPU per simulated second
+   over the first 0.1 s at k_c = 1e8 ... 1e11 N/m (docs/img/bearing_cost_kc.png).
 Writes docs/bench_spin.json; docs/benchmarks.md quotes it.
 """
 
@@ -177,6 +182,78 @@ def timed(repeats: int) -> dict[str, Any]:
     return out
 
 
+BEARING = {"mu": 0.15, "d": 0.9, "race_turns": True, "J_b": 2e-4, "T_b0": 0.02,
+           "c_bw": 1e-5, "omega_b0": 0.0, "support_compliant": True, "m_b": 2.0, "k_b": 5e7,
+           "c_b": 2e3, "contact_compliant": True, "k_c": 1e9, "p_c": 1.0}
+"""The real bearing of issue 24's drop (docs/model.md §10)."""
+K_C_SWEEP = (1e8, 1e9, 1e10, 1e11)
+T_SWEEP = 0.1
+
+
+def simulate_bearing(fmu: tuple[str, Any], t_end: float, k_c: float) -> tuple[float, Any]:
+    """CPU seconds of one simulate_fmu run of the drop onto the real bearing, its rows."""
+    from fmpy import simulate_fmu
+
+    unzip, md = fmu
+    t0 = time.process_time()
+    res = simulate_fmu(unzip, validate=False, model_description=md, stop_time=t_end,
+                       output_interval=H,
+                       start_values={**drop_start_values(), **BEARING, "k_c": k_c},
+                       output=[*B.ALL_OUT, "Omega_out", "omega_b"])
+    return time.process_time() - t0, res
+
+
+def timed_bearing(repeats: int) -> dict[str, Any]:
+    """The drop onto the real bearing, 3000 steps, FMU against the floor (median of
+    ``repeats``, alternating), and the FMU's cost against k_c over T_SWEEP s."""
+    with tempfile.TemporaryDirectory() as tmp:
+        fmus = B.build_fmus(Path(tmp))
+        fmu, floor = fmus["RotorTouchdown"], fmus["RotorTouchdownFloor"]
+        t_fmu, t_floor = [], []
+        for _ in range(repeats):
+            cpu, res = simulate_bearing(fmu, T_END, BEARING["k_c"])
+            t_fmu.append(cpu)
+            t_floor.append(simulate_bearing(floor, T_END, BEARING["k_c"])[0])
+        sweep = {}
+        for k_c in K_C_SWEEP:
+            sweep[f"{k_c:g}"] = simulate_bearing(fmu, T_SWEEP, k_c)[0] / T_SWEEP
+            print(f"k_c = {k_c:g} N/m: {sweep[f'{k_c:g}']:.2f} s CPU per simulated second")
+    out = {"fmu_cpu_s": t_fmu, "floor_cpu_s": t_floor,
+           "ratio": statistics.median(t_fmu) / statistics.median(t_floor),
+           "steps": round(T_END / H), "Omega_end": float(res["Omega_out"][-1]),
+           "omega_b_end": float(res["omega_b"][-1]),
+           "F_n_peak_max": float(res["F_n_peak"].max()),
+           "cpu_per_simulated_s_vs_k_c": sweep, "sweep_span_s": T_SWEEP}
+    print(f"drop onto the real bearing, {out['steps']} steps of {H:g} s: FMU "
+          f"{statistics.median(t_fmu):.3f} s CPU, floor {statistics.median(t_floor):.3f} s; "
+          f"FMU/floor = {out['ratio']:.1f} (issue 24's target <= 10)")
+    return out
+
+
+def plot_bearing_cost(out: dict[str, Any]) -> Path:
+    """docs/img/bearing_cost_kc.png: CPU per simulated second against k_c."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ks = [float(k) for k in out["cpu_per_simulated_s_vs_k_c"]]
+    cpu = list(out["cpu_per_simulated_s_vs_k_c"].values())
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog(ks, cpu, "o-", label="RotorTouchdown, the drop onto the real bearing")
+    floor = statistics.median(out["floor_cpu_s"]) / T_END
+    ax.axhline(floor, color="grey", ls="--", label="floor FMU")
+    ax.axhline(10 * floor, color="grey", ls=":", label="10 x floor (issue 24's target)")
+    ax.set_xlabel("contact stiffness k_c at 10 um [N/m]")
+    ax.set_ylabel("CPU seconds per simulated second")
+    ax.set_title(f"first {out['sweep_span_s']:g} s of the drop, step 1e-4 s, FMPy")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path = B.ROOT / "docs" / "img" / "bearing_cost_kc.png"
+    fig.savefig(path, dpi=110)
+    return path
+
+
 def instructions() -> dict[str, float]:
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -196,7 +273,16 @@ def main() -> int:
     ap.add_argument("--no-valgrind", action="store_true")
     ap.add_argument("--quiet-only", action="store_true",
                     help="only count the quiet spin-state FMU step (3.), ~5 min")
+    ap.add_argument("--bearing", action="store_true",
+                    help="only the drop onto the real bearing (4.): FMU against the floor "
+                         "and the cost against k_c, into the existing file, ~5 min")
     args = ap.parse_args()
+    if args.bearing:
+        result = json.loads(OUT.read_text()) if OUT.exists() else {}
+        result["real_bearing"] = rb = timed_bearing(args.repeats)
+        OUT.write_text(json.dumps(result, indent=1) + "\n")
+        print(f"wrote {OUT.relative_to(B.ROOT)} and {plot_bearing_cost(rb).relative_to(B.ROOT)}")
+        return 0
     if args.quiet_only:  # only the quiet spin-state FMU step, into the existing file
         result = json.loads(OUT.read_text()) if OUT.exists() else {}
         result["quiet_fmu_step"] = quiet_fmu_steps()
