@@ -349,6 +349,7 @@ REAL_PARAMETERS = {params!r}
 TUNABLE = {tunable!r}
 INPUTS = {inputs!r}
 REAL_OUTPUTS = {outputs!r}
+FIXED_OTHER = {fixed_other!r}
 PUBLISH_SOURCE = {publisher!r}
 STATE_VALUES = {state_values!r}
 REPORT_PUBLISH_SOURCE = {report_publisher!r}
@@ -360,8 +361,8 @@ _publish = _namespace["publish"]
 
 class _QuietReport:
     """A quiet step's report, as the real adapter reads it."""
-    F_contact = 0j
-    F_n = F_n_peak = P_n = T_f = T_imb = 0.0
+    F_contact = F_support = 0j
+    F_n = F_n_peak = P_n = T_f = T_imb = P_fric = 0.0
     impacts = ()
 
 
@@ -379,9 +380,9 @@ class RotorTouchdownFloorAdapter(Fmi2Slave):
             setattr(self, name, start)
             self.register_variable(Real(name, causality=par,
                                         variability=tun if name in TUNABLE else fixed))
-        for name, val, cls in (("levitate", True, Boolean), ("start_steady", False, Boolean),
-                               ("impact_log", "", String)):
+        for name, val, kind in FIXED_OTHER:
             setattr(self, name, val)
+            cls = Boolean if kind == "Boolean" else String
             self.register_variable(cls(name, causality=par, variability=fixed))
         for name, start, _d in INPUTS:
             setattr(self, name, start)
@@ -437,6 +438,8 @@ def _adapter_tables() -> dict[str, Any]:
     return {"meta": mod.VARIABLE_META, "params": rows("parameter"),
             "tunable": set(mod.TUNABLE), "inputs": rows("input"),
             "outputs": tuple((n, d) for n, _s, d in rows("output")),
+            "fixed_other": tuple((v.name, v.start, v.type) for v in TABLE
+                                 if v.causality == "parameter" and v.type != "Real"),
             "publisher": mod.publisher_source(core.outputs()._fields),
             "report_publisher": textwrap.dedent(
                 inspect.getsource(mod.RotorTouchdownAdapter._publish_step_outputs)),

@@ -140,6 +140,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._seen_inputs: tuple | None = None
         self._h_spin_warned = False  # h_spin is deprecated: warned once if set
         self._spin_state = False  # the core's spin_is_state, read once per core
+        self._race_outputs = False  # a real bearing's outputs to publish (core.race)
 
     def _watched_setter(self, name: str) -> Any:
         """FMI setter of a parameter or input: stores the value and marks the values as
@@ -170,6 +171,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         try:
             self._core = self._make_core(rotortd)
             self._spin_state = self._core.spin_is_state
+            self._race_outputs = self._core.race is not None
             self._publish = state_publisher(self._core.outputs()._fields)
         except rotortd.CrossParameterError as exc:
             raise ModelError(f"cross-parameter constraint: {exc}") from exc
@@ -323,6 +325,8 @@ class RotorTouchdownAdapter(GuardedSlave):
         # (the spin: the held input or the core's state)
         total = (self._publish_state(None, amb, bool(rep.impacts or rep.transitions))
                  + self._publish_step_outputs(rep))
+        if self._race_outputs:  # a real bearing (docs/model.md §10)
+            total += self._publish_race(rep)
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
         if rep.status == 0 and abs(core.t - t_target) <= tol:
@@ -373,8 +377,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             self.F_bx = self.F_by = self.F_n = self.F_n_peak = self.P_n = self.T_f = 0.0
             self.T_imb = self.F_sx = self.F_sy = self.P_fric = 0.0
             self.n_impacts_step = 0
-            self._publish_race(None)
-            return 0.0
+            return self._publish_race(None)
         F = rep.F_contact
         self.F_bx = fx = F.real
         self.F_by = fy = F.imag
@@ -384,14 +387,13 @@ class RotorTouchdownAdapter(GuardedSlave):
         self.T_f = T_f = rep.T_f
         self.T_imb = T_imb = rep.T_imb
         self.n_impacts_step = len(rep.impacts)
-        if self._core.race is None:  # the fixed bearing passes the contact force on
-            self.F_sx, self.F_sy = -fx, -fy
-            return fx + fy + F_n + peak + P_n + T_f + T_imb
-        return fx + fy + F_n + peak + P_n + T_f + T_imb + self._publish_race(rep)
+        self.F_sx, self.F_sy = -fx, -fy  # the fixed bearing passes the contact force on
+        return fx + fy + F_n + peak + P_n + T_f + T_imb
 
     def _publish_race(self, rep: Any) -> float:
-        """Publish the real bearing's outputs (zeros for the fixed bearing); return their
-        sum (for the non-finite check)."""
+        """Publish the real bearing's outputs after ``_publish_step_outputs`` (zeros for the
+        fixed bearing; its F_sx, F_sy are -F_contact); return their sum (for the non-finite
+        check)."""
         race = None if self._core is None else self._core.race
         if race is None:
             self.omega_b = self.x_b = self.y_b = self.vx_b = self.vy_b = 0.0
@@ -478,6 +480,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._core = core
         if core is not None:
             self._spin_state = core.spin_is_state
+            self._race_outputs = core.race is not None
             self._publish = state_publisher(core.outputs()._fields)
         for name, value in values.items():
             setattr(self, name, value)
