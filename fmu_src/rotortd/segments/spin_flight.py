@@ -159,6 +159,13 @@ class SpinFlight:
     path added to the rotor's (|z - c| <= c_r, |z| <= c_r + |c|).
     """
 
+    __slots__ = ("E0", "F0", "F0_abs", "F_ext", "J", "Om0", "Om_scale", "T", "_k", "_limit",
+                 "_starts", "_steps", "a", "alpha", "bearing", "cA", "closed", "cr", "ec",
+                 "f0m", "f0m_abs", "g", "horizon", "kA", "m", "moving", "p", "psi0", "v0", "w",
+                 "wG0", "z0", "zG0")
+    # (slots: more attributes than an instance's shared-key dict holds; without them every
+    # run's self._limit rebuilt the instance's dict, +3 % of a closed-form flight's step)
+
     def __init__(
         self,
         p: RotorParams,

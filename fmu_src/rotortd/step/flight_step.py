@@ -58,12 +58,8 @@ class FlightSteps:
         caller searches). Either way the step ends in the same state as a search that finds
         nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
-        psi = self._psi
-        if self._E_of is psi:  # (_phasor, inline: the quiet step; output_values set it)
-            E = self._E_at
-        else:
-            E = self._E_at = complex(math.cos(psi), math.sin(psi))
-            self._E_of = psi
+        psi = self._psi  # (_phasor, inline, storing nothing: in an FMU, output_values
+        E = self._E_at if self._E_of is psi else cmath.exp(1j * psi)  # cached this angle's)
         work = 1
         if not self._clear:
             if self._on_wall:
@@ -113,12 +109,12 @@ class FlightSteps:
     _E_at: complex = 1.0 + 0j
 
     def _phasor(self) -> complex:
-        """e^{i psi}, the same bits as cmath.exp(1j psi) (whose real part is then exp(+-0)
-        = 1: cos psi + i sin psi), computed once per spin angle: the quiet step and
-        output_values share it."""
+        """e^{i psi}, computed once per spin angle: the quiet step and output_values share
+        it. (cmath.exp(1j psi) has the bits of complex(cos psi, sin psi), its real part
+        being exp(+-0) = 1, at half the instructions.)"""
         psi = self._psi
         if self._E_of is not psi:
-            self._E_at = complex(math.cos(psi), math.sin(psi))
+            self._E_at = cmath.exp(1j * psi)
             self._E_of = psi
         return self._E_at
 
