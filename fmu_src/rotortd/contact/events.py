@@ -28,3 +28,11 @@ class Event(str, enum.Enum):
     """Sliding (held spin): zero slip that sliding cannot leave; rolling follows."""
     SLIP_START = "slip_start"
     """Rolling: the static friction needed reaches mu N (the friction cone's edge)."""
+
+
+# The members as module constants, for the hot paths (segment ends, event functions): in
+# Python 3.11 reading ``Event.X`` passes through EnumType.__getattr__'s hook, ~900
+# instructions; a module constant, ~20. The same objects (``CONTACT is Event.CONTACT``).
+IMPACT, TOUCH, CLEAR, CONTACT = Event.IMPACT, Event.TOUCH, Event.CLEAR, Event.CONTACT
+LIFT_OFF, SLIP_ZERO, SLIP_STUCK = Event.LIFT_OFF, Event.SLIP_ZERO, Event.SLIP_STUCK
+SLIP_START = Event.SLIP_START

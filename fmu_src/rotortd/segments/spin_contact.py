@@ -35,7 +35,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from ..contact.events import Event
+from ..contact.events import LIFT_OFF, SLIP_START, SLIP_ZERO
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
@@ -222,10 +222,10 @@ class SpinContact:
         and in rolling mu N - |F_t| (slip start), in sliding s v_rel (slip zero)."""
         N, Ft = self._forces(y)[:2]
         if self.rolling:
-            return [(Event.LIFT_OFF, N + self.n_slack),
-                    (Event.SLIP_START, self.model.mu * N - abs(Ft))]
+            return [(LIFT_OFF, N + self.n_slack),
+                    (SLIP_START, self.model.mu * N - abs(Ft))]
         vrel = self.model.R * y[3] + self.model.c_r * y[1]
-        return [(Event.LIFT_OFF, N + self.n_slack), (Event.SLIP_ZERO, vrel * self.s)]
+        return [(LIFT_OFF, N + self.n_slack), (SLIP_ZERO, vrel * self.s)]
 
     def _margin(self, y: Vector) -> float:
         """The least event function (continuous; its first zero is the first event)."""

@@ -30,7 +30,7 @@ import cmath
 import math
 from collections.abc import Callable
 
-from ..contact.events import Event
+from ..contact.events import CLEAR, IMPACT
 from ..contact.impact import Impact, reset
 from ..contact.search import WORK_MAX, ContactLocator, Work, flight_is_clear
 from ..contact.wall import SegmentEnd, WallForces
@@ -169,13 +169,13 @@ class FlightSteps:
         elif imb:
             self._imb_add(rep, E, fm.imb_integral(z0, v0, E, ds))
         self._advance_psi(ds)
-        if end.event is Event.CLEAR:
+        if end.event is CLEAR:
             self._z, self._v = end.z, end.v
             self._on_wall = False
             return st.later(s, ds)
         z = end.z * (self._p.c_r / abs(end.z))
         self._forget_clear_proof()
-        if end.event is Event.IMPACT:
+        if end.event is IMPACT:
             self._impact(t0 + s + (st.s_lo + ds), z, end.v, rep)
         else:
             self._z, self._v = z, end.v
