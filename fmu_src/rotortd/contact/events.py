@@ -37,3 +37,13 @@ class Event(str, enum.Enum):
     """Contact, turning race with static friction: its spin reaches 0."""
     BREAKAWAY = "breakaway"
     """Contact, race held at rest: the static torque that holds it reaches T_b0."""
+
+
+# The members as module constants, for the hot paths (segment ends, event functions): in
+# Python 3.11 reading ``Event.X`` passes through EnumType.__getattr__'s hook, ~900
+# instructions; a module constant, ~20. The same objects (``CONTACT is Event.CONTACT``).
+IMPACT, TOUCH, CLEAR, CONTACT = Event.IMPACT, Event.TOUCH, Event.CLEAR, Event.CONTACT
+LIFT_OFF, SLIP_ZERO, SLIP_STUCK = Event.LIFT_OFF, Event.SLIP_ZERO, Event.SLIP_STUCK
+SLIP_START = Event.SLIP_START
+SEPARATE, CLAMP_END, RACE_STOP, BREAKAWAY = (Event.SEPARATE, Event.CLAMP_END, Event.RACE_STOP,
+                                             Event.BREAKAWAY)

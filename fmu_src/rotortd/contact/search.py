@@ -38,7 +38,7 @@ import math
 from dataclasses import dataclass
 
 from ..segments.flight import FlightModel, Modes
-from .events import Event
+from .events import CLEAR, IMPACT, TOUCH, Event
 
 EPS = 2.220446049250313e-16
 TOL_G_ULPS = 64.0
@@ -429,7 +429,7 @@ class ContactLocator:
                     u = tau
                 if u <= 0.0:
                     # at the wall with g1 = g2 = 0 and nothing pushing: treat as touch
-                    return Contact(s, z, v, E, Event.TOUCH)
+                    return Contact(s, z, v, E, TOUCH)
                 s = s + u if u < remaining else h
             if modal == 0:
                 md = self._get_modes()
@@ -446,7 +446,7 @@ class ContactLocator:
             e2 = a2 * exp(l2 * s)
             zs = Z1 * rot
             z, v, E = Z0 + zs + e1 + e2, iw * zs + l1 * e1 + l2 * e2, E0 * rot
-        return Contact(s, z, v, E, Event.CLEAR)  # proved free of contact up to s; resume there
+        return Contact(s, z, v, E, CLEAR)  # proved free of contact up to s; resume there
 
     def _at_wall(
         self,
@@ -469,12 +469,12 @@ class ContactLocator:
             outward = g + g1 * g1 / (-2.0 * g2) > self.tol_g  # resolvable excursion
         if outward:
             if first:
-                return Contact(s, z, v, E, Event.IMPACT)
+                return Contact(s, z, v, E, IMPACT)
             return self._polish(s, z, v, E, g, g1, work)
         if g1 < -tol_g1:
             return None
         if g2 > tol_g2 or (g2 >= -tol_g2 and self.g3(z, v, E) > 0.0):
-            return Contact(s, z, v, E, Event.TOUCH)
+            return Contact(s, z, v, E, TOUCH)
         return None
 
     def _polish(
@@ -497,4 +497,4 @@ class ContactLocator:
             if abs(g) <= 4.0 * EPS * self.c2:
                 break
         _, s, z, v, E = best
-        return Contact(s, z, v, E, Event.IMPACT)
+        return Contact(s, z, v, E, IMPACT)

@@ -50,7 +50,16 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ..contact.events import Event
+from ..contact.events import (
+    BREAKAWAY,
+    CLAMP_END,
+    LIFT_OFF,
+    RACE_STOP,
+    SEPARATE,
+    SLIP_START,
+    SLIP_ZERO,
+    Event,
+)
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactWorkExceeded
 from . import gbs
@@ -277,18 +286,18 @@ class BearingModel:
         law, cs = self.law, self.cs
         out: list[tuple[Event, float]] = []
         if law.compliant:
-            out.append((Event.SEPARATE, f.delta))
+            out.append((SEPARATE, f.delta))
             if cs.clamped:
-                return [*out, (Event.CLAMP_END, -f.N_law), *self._race_events(y, f)]
-            out.append((Event.LIFT_OFF, f.N_law + n_slack))
+                return [*out, (CLAMP_END, -f.N_law), *self._race_events(y, f)]
+            out.append((LIFT_OFF, f.N_law + n_slack))
         else:
-            out.append((Event.LIFT_OFF, f.N + n_slack))
+            out.append((LIFT_OFF, f.N + n_slack))
         if self.mu == 0.0:  # no friction: the slip has no events
             pass
         elif cs.s != 0.0:
-            out.append((Event.SLIP_ZERO, cs.s * f.vrel))
+            out.append((SLIP_ZERO, cs.s * f.vrel))
         else:
-            out.append((Event.SLIP_START, self.mu * f.N - abs(f.F_t)))
+            out.append((SLIP_START, self.mu * f.N - abs(f.F_t)))
         return out + self._race_events(y, f)
 
     def _race_events(self, y: Vector, f: BearingForces) -> list[tuple[Event, float]]:
@@ -296,8 +305,8 @@ class BearingModel:
         if not law.turns or law.T_b0 == 0.0:
             return []
         if self.cs.race_held:
-            return [(Event.BREAKAWAY, law.T_b0 - law.R_b * abs(f.F_t))]
-        return [(Event.RACE_STOP, self.cs.s_b * y[10])]
+            return [(BREAKAWAY, law.T_b0 - law.R_b * abs(f.F_t))]
+        return [(RACE_STOP, self.cs.s_b * y[10])]
 
     def project(self, y: Vector) -> None:
         """Rigid law: put y back onto the constraint (in place): the rotor's centre onto the

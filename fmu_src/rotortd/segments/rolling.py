@@ -11,7 +11,7 @@ import cmath
 import math
 from dataclasses import dataclass
 
-from ..contact.events import Event
+from ..contact.events import LIFT_OFF, SLIP_START
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, SegmentEnd, WallForces, phase_integral
 from ..scaled import wrap_angle
@@ -122,7 +122,7 @@ class Rolling:
         whatever ``limit``."""
         cone_slack = self.cone_slack
         tally = ContactTally()
-        names = (Event.LIFT_OFF, Event.SLIP_START, Event.SLIP_START)
+        names = (LIFT_OFF, SLIP_START, SLIP_START)
         # an exit happens once its function is past the rounding band that the mode
         # choice (simulator: _leaves_wall, _choose_contact_mode) also uses
         band = self.wf.gn_tol(self.dtheta)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import cmath
 import math
 
-from ..contact.events import Event
+from ..contact.events import LIFT_OFF, SLIP_STUCK, SLIP_ZERO, Event
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces
 from . import gbs
@@ -317,8 +317,8 @@ class Sliding:
             else:  # never off the surface: the event is immediate
                 y_x, _ = at(H * 2.0**-40)
                 kind = self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
-                stuck = kind is Event.SLIP_ZERO and abs(sv0) <= noise * s_v
-                return H * 2.0**-40, y_x, Event.SLIP_STUCK if stuck else kind
+                stuck = kind is SLIP_ZERO and abs(sv0) <= noise * s_v
+                return H * 2.0**-40, y_x, SLIP_STUCK if stuck else kind
         _, hi, y_best = illinois(
             lambda x: at(x)[::-1], lo, flo, H, fhi, y_hi,
             lambda lo, hi, _: hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300, 100, noise)
@@ -326,4 +326,4 @@ class Sliding:
 
     def _kind(self, y: list[float], u: float, s_n: float, s_v: float) -> Event:
         gn, sv = self.events(y, u)
-        return Event.LIFT_OFF if gn / s_n <= sv / s_v else Event.SLIP_ZERO
+        return LIFT_OFF if gn / s_n <= sv / s_v else SLIP_ZERO

@@ -35,7 +35,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from ..contact.events import Event
+from ..contact.events import LIFT_OFF, SLIP_START, SLIP_ZERO
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
@@ -90,7 +90,8 @@ class ContactModel:
     """The held inputs as plain floats, and the contact's forces at a state in real
     arithmetic (SI; one cos/sin pair each for theta and psi + phi)."""
 
-    __slots__ = ("J", "R", "T", "ac", "ak", "c_r", "e_c", "fx", "fy", "m", "mg", "mu", "phi")
+    __slots__ = ("J", "R", "T", "ac", "ak", "c_r", "cr_ak", "e_c", "fx", "fy", "m", "m_cr", "m_ec",
+                 "mg", "mu", "phi")
 
     def __init__(self, h: HeldInputs) -> None:
         p = h.p
@@ -98,6 +99,9 @@ class ContactModel:
         self.m, self.c_r, self.R, self.e_c, self.phi = p.m, p.c_r, p.R, p.e_c, p.phi
         self.mu, self.J, self.T, self.mg = p.mu, h.J, h.T_drive, p.m * p.g
         self.ac, self.ak = h.a * p.c, h.a * p.k
+        # products of constants, formed once (each is the leading product of the expressions
+        # below, evaluated left to right, so the same bits): kg m, kg m, N
+        self.m_ec, self.m_cr, self.cr_ak = p.m * p.e_c, p.m * p.c_r, p.c_r * self.ak
         self.fx, self.fy = F1.real, F1.imag
 
     def _known(self, ct: float, st: float, dtheta: float, psi: float, Omega: float
@@ -105,26 +109,25 @@ class ContactModel:
         """(B, A, rhs_n, F_ot, T, cos beta) at the contact state with n = ct + i st:
         rhs_n = Re(conj(n) F_o) + m c_r theta'^2 (N), F_ot = Im(conj(n) F_o) (N),
         T = T_drive + T_o (N m)."""
-        c_r, e_c, m = self.c_r, self.e_c, self.m
+        c_r, e_c = self.c_r, self.e_c
         ang = psi + self.phi
         cE, sE = math.cos(ang), math.sin(ang)
-        w, ck, ca = c_r * dtheta, c_r * self.ak, self.ac
+        w, ck, ca = c_r * dtheta, self.cr_ak, self.ac
         Fr = self.fx + ca * w * st - ck * ct  # F_amb + F_ext, z = c_r n, v = i c_r theta' n
         Fi = self.fy - ca * w * ct - ck * st
         T = self.T + e_c * (Fr * sE - Fi * cE)
-        u = m * e_c * Omega * Omega
+        u = self.m_ec * Omega * Omega
         Gr, Gi = Fr + u * cE, Fi - self.mg + u * sE  # F_o
         cb, sb = cE * ct + sE * st, sE * ct - cE * st  # e^{i beta} = conj(n) E
-        return (e_c * sb, self.R - e_c * cb, Gr * ct + Gi * st + m * c_r * dtheta * dtheta,
+        return (e_c * sb, self.R - e_c * cb, Gr * ct + Gi * st + self.m_cr * dtheta * dtheta,
                 Gi * ct - Gr * st, T, cb)
 
     def normal_tol(self, theta: float, dtheta: float, psi: float, Omega: float) -> float:
         """The rounding band of N (N): 64 eps times the magnitudes of its terms."""
         ct, st = math.cos(theta), math.sin(theta)
         _, A, _, _, T, _ = self._known(ct, st, dtheta, psi, Omega)
-        m = self.m
         scale = (abs(self.fx) + abs(self.fy) + self.mg + (self.ac * abs(dtheta) + self.ak)
-                 * self.c_r + m * self.e_c * Omega * Omega + m * self.c_r * dtheta * dtheta
+                 * self.c_r + self.m_ec * Omega * Omega + self.m_cr * dtheta * dtheta
                  + abs(T) / max(abs(A), 1e-300))
         return 64.0 * 2.220446049250313e-16 * scale
 
@@ -141,7 +144,7 @@ class ContactModel:
         dW = (T - k * rn) / (self.J + m * B * k)
         N = rn + m * B * dW
         Ft = mus * N
-        return N, Ft, (Fot - Ft - m * self.e_c * cb * dW) / (m * self.c_r), dW, ct, st
+        return N, Ft, (Fot - Ft - self.m_ec * cb * dW) / self.m_cr, dW, ct, st
 
     def rolling(self, theta: float, psi: float, Omega: float
                 ) -> tuple[float, float, float, float, float, float]:
@@ -222,10 +225,10 @@ class SpinContact:
         and in rolling mu N - |F_t| (slip start), in sliding s v_rel (slip zero)."""
         N, Ft = self._forces(y)[:2]
         if self.rolling:
-            return [(Event.LIFT_OFF, N + self.n_slack),
-                    (Event.SLIP_START, self.model.mu * N - abs(Ft))]
+            return [(LIFT_OFF, N + self.n_slack),
+                    (SLIP_START, self.model.mu * N - abs(Ft))]
         vrel = self.model.R * y[3] + self.model.c_r * y[1]
-        return [(Event.LIFT_OFF, N + self.n_slack), (Event.SLIP_ZERO, vrel * self.s)]
+        return [(LIFT_OFF, N + self.n_slack), (SLIP_ZERO, vrel * self.s)]
 
     def _margin(self, y: Vector) -> float:
         """The least event function (continuous; its first zero is the first event)."""

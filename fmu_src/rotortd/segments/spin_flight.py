@@ -95,7 +95,7 @@ import math
 from operator import mul
 
 from ..bodies.bearing import CounterBody
-from ..contact.events import Event
+from ..contact.events import CONTACT
 from ..contact.search import WORK_MAX, Work, _negative_throughout, safe_step
 from ..contact.wall import ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
@@ -158,6 +158,13 @@ class SpinFlight:
     the search follows the gap to it, G = |z - c(s)|^2/c_r^2 - 1, with the bounds of its
     path added to the rotor's (|z - c| <= c_r, |z| <= c_r + |c|).
     """
+
+    __slots__ = ("E0", "F0", "F0_abs", "F_ext", "J", "Om0", "Om_scale", "T", "_k", "_limit",
+                 "_starts", "_steps", "a", "alpha", "bearing", "cA", "closed", "cr", "ec",
+                 "f0m", "f0m_abs", "g", "horizon", "kA", "m", "moving", "p", "psi0", "v0", "w",
+                 "wG0", "z0", "zG0")
+    # (slots: more attributes than an instance's shared-key dict holds; without them every
+    # run's self._limit rebuilt the instance's dict, +3 % of a closed-form flight's step)
 
     def __init__(
         self,
@@ -442,10 +449,10 @@ class SpinFlight:
                 kind = self._at_wall(g0, g1, g2, g3, M1, M2, 3.0 * rho)
                 if kind == "impact":
                     if s == 0.0:
-                        return self._end(0.0, z, v, dpsi, Om, Event.CONTACT, work)
+                        return self._end(0.0, z, v, dpsi, Om, CONTACT, work)
                     return self._polish(s, z, v, dpsi, Om, rem, work)
                 if kind == "touch":
-                    return self._end(s, z, v, dpsi, Om, Event.CONTACT, work)
+                    return self._end(s, z, v, dpsi, Om, CONTACT, work)
                 if kind == "graze":
                     if s >= rem:
                         return self._end(rem, z, v, dpsi, Om, None, work)
@@ -469,7 +476,7 @@ class SpinFlight:
             if u is None:
                 u = tau
             elif u <= 0.0:  # on the wall, nothing moving it: a touch
-                return self._end(s, z, v, dpsi, Om, Event.CONTACT, work)
+                return self._end(s, z, v, dpsi, Om, CONTACT, work)
             s = s + u if u < remaining else rem
             z, v, dpsi, Om, E = self.state(s, work)
 
@@ -603,10 +610,10 @@ class SpinFlight:
                 kind = self._at_wall(g0, g1, g2, g3, M1, M2)
                 if kind == "impact":
                     if s == 0.0:
-                        return self._end(0.0, z, v, dpsi, Om, Event.CONTACT, work)
+                        return self._end(0.0, z, v, dpsi, Om, CONTACT, work)
                     return self._polish(s, z, v, dpsi, Om, rem, work)
                 if kind == "touch":
-                    return self._end(s, z, v, dpsi, Om, Event.CONTACT, work)
+                    return self._end(s, z, v, dpsi, Om, CONTACT, work)
                 if kind == "graze":
                     if s >= rem:
                         return self._end(rem, z, v, dpsi, Om, None, work)
@@ -634,7 +641,7 @@ class SpinFlight:
             if u is None:
                 u = tau
             elif u <= 0.0:  # on the wall, nothing moving it: a touch
-                return self._end(s, z, v, dpsi, Om, Event.CONTACT, work)
+                return self._end(s, z, v, dpsi, Om, CONTACT, work)
             s = s + u if u < remaining else rem
             # state(s), closed form
             work.evals += POINT_WORK
@@ -695,7 +702,7 @@ class SpinFlight:
         if s > rem:  # the root lies beyond the segment: end there, just inside the wall
             z, v, dpsi, Om, _ = self.state(rem, work)
             return self._end(rem, z, v, dpsi, Om, None, work)
-        return self._end(s, z, v, dpsi, Om, Event.CONTACT, work)
+        return self._end(s, z, v, dpsi, Om, CONTACT, work)
 
     def _gap(self, s: float, z: complex, v: complex, ic2: float) -> tuple[float, float]:
         """(G, G') at s of the rotor's (z, v): the gap to the counter-body's circle."""
@@ -709,13 +716,13 @@ class SpinFlight:
     def _end(self, s: float, z: complex, v: complex, dpsi: float, Om: float,
              event: str | None, work: Work) -> SegmentEnd:
         """The segment's end at s; a contact's z is projected onto the circle."""
-        if event is Event.CONTACT and self.moving:
+        if event is CONTACT and self.moving:
             assert self.bearing is not None
             c = self.bearing.path(s)[0]
             r = abs(z - c)
             if r > 0.0:
                 z = c + (z - c) * (self.cr / r)
-        elif event is Event.CONTACT:
+        elif event is CONTACT:
             r = abs(z)
             if r > 0.0:
                 z = z * (self.cr / r)

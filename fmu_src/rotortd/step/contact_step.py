@@ -11,7 +11,7 @@ from __future__ import annotations
 import cmath
 import math
 
-from ..contact.events import Event
+from ..contact.events import LIFT_OFF, SLIP_START, SLIP_STUCK, Event
 from ..contact.wall import SegmentEnd, WallForces
 from ..scaled import wrap_angle
 from ..segments.rolling import Rolling
@@ -169,17 +169,17 @@ class ContactSteps:
         rotor's model (``_roll_or_slide``, ``_cone_sign``: bound by ``_bind_rotor``)."""
         if event is None:
             return
-        if event is Event.LIFT_OFF:
+        if event is LIFT_OFF:
             self._lift_off()
             return
         assert st is not None
         self._locked = False
-        if event is Event.SLIP_START:
+        if event is SLIP_START:
             self._mode, self._slip = MODE_SLIDING, self._cone_sign(st)
             return
         p = self._p
         self._dtheta = -p.R * self._inputs[0] / p.c_r  # (= -WallForces.wr, bit for bit)
-        if event is Event.SLIP_STUCK:
+        if event is SLIP_STUCK:
             self._mode = MODE_ROLLING
             st.roll_lenient = True
         else:

@@ -30,7 +30,7 @@ import cmath
 import math
 from collections.abc import Callable
 
-from ..contact.events import Event
+from ..contact.events import CLEAR, IMPACT
 from ..contact.impact import Impact, reset
 from ..contact.search import WORK_MAX, ContactLocator, Work, flight_is_clear
 from ..contact.wall import SegmentEnd, WallForces
@@ -58,12 +58,8 @@ class FlightSteps:
         caller searches). Either way the step ends in the same state as a search that finds
         nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
-        psi = self._psi
-        if self._E_of is psi:  # (_phasor, inline: the quiet step; output_values set it)
-            E = self._E_at
-        else:
-            E = self._E_at = complex(math.cos(psi), math.sin(psi))
-            self._E_of = psi
+        psi = self._psi  # (_phasor, inline, storing nothing: in an FMU, output_values
+        E = self._E_at if self._E_of is psi else cmath.exp(1j * psi)  # cached this angle's)
         work = 1
         if not self._clear:
             if self._on_wall:
@@ -113,12 +109,12 @@ class FlightSteps:
     _E_at: complex = 1.0 + 0j
 
     def _phasor(self) -> complex:
-        """e^{i psi}, the same bits as cmath.exp(1j psi) (whose real part is then exp(+-0)
-        = 1: cos psi + i sin psi), computed once per spin angle: the quiet step and
-        output_values share it."""
+        """e^{i psi}, computed once per spin angle: the quiet step and output_values share
+        it. (cmath.exp(1j psi) has the bits of complex(cos psi, sin psi), its real part
+        being exp(+-0) = 1, at half the instructions.)"""
         psi = self._psi
         if self._E_of is not psi:
-            self._E_at = complex(math.cos(psi), math.sin(psi))
+            self._E_at = cmath.exp(1j * psi)
             self._E_of = psi
         return self._E_at
 
@@ -173,13 +169,13 @@ class FlightSteps:
         elif imb:
             self._imb_add(rep, E, fm.imb_integral(z0, v0, E, ds))
         self._advance_psi(ds)
-        if end.event is Event.CLEAR:
+        if end.event is CLEAR:
             self._z, self._v = end.z, end.v
             self._on_wall = False
             return st.later(s, ds)
         z = end.z * (self._p.c_r / abs(end.z))
         self._forget_clear_proof()
-        if end.event is Event.IMPACT:
+        if end.event is IMPACT:
             self._impact(t0 + s + (st.s_lo + ds), z, end.v, rep)
         else:
             self._z, self._v = z, end.v
