@@ -103,6 +103,33 @@ def test_single_compliant_impact_matches_its_closed_form(p_c: float, d: float) -
     assert rep.impacts == []  # a compliant contact has no impulse
 
 
+def test_a_slow_closure_gets_the_floor_damping() -> None:
+    """docs/model.md §10: chi = c_d/max(v_in, v_floor), v_floor = 1e-3 m/s: a contact that
+    closes at 1e-4 m/s is damped as one closing at v_floor, so it rebounds faster than
+    d v_in. Against an independent integration of m x'' = -K x (1 + chi x') (scipy DOP853,
+    rtol 1e-12) from x = 0, x' = v_in to the exit."""
+    from scipy.integrate import solve_ivp
+
+    v_in, d = 1e-4, 0.9
+    core, t_close = _single_impact_core(1.0, d, v_in)
+    m, k_c = core.params.m, 1e9
+    chi = rb.c_d(d) / 1e-3
+
+    def rhs(_t: float, y: list[float]) -> list[float]:
+        return [y[1], -k_c * y[0] * (1.0 + chi * y[1]) / m]
+
+    def out(_t: float, y: list[float]) -> float:
+        return y[0]
+
+    out.terminal, out.direction = True, -1.0  # type: ignore[attr-defined]
+    sol = solve_ivp(rhs, (0.0, 1.0), [0.0, v_in], method="DOP853", rtol=1e-12, atol=1e-20,
+                    events=out)
+    v_exit = -float(sol.y_events[0][0][1])
+    assert v_exit > 1.05 * d * v_in  # less damping than an impact at v_in would get
+    core.step(t_close + 2.0 * float(sol.t_events[0][0]), None, 0j, 0.0, T_drive=0.0)
+    assert -core.v.real == pytest.approx(v_exit, rel=1e-9)
+
+
 def test_rigid_impact_on_a_sprung_race_matches_its_closed_form() -> None:
     p = RotorParams(e_c=0.0, g=0.0, mu=0.0, d=0.95, levitate=False)
     bp = BearingParams(support_compliant=True, m_b=2.0, k_b=5e7, c_b=2e3)

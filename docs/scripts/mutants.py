@@ -232,6 +232,29 @@ MUTANTS: tuple[Mutant, ...] = (
     M("T3", "state round trip", "the clock's rounding error is not restored (t_lo)",
       '("clock.t_lo", "t_lo", FLOAT),', '("clock.t_lo", "t_lo", Codec(lambda x: 0.0, float)),',
       ("tests/test_core_state.py",)),
+    # ---------------------------------------------------------------- the real bearing (24)
+    M("B1", "real bearing: compliant law", "the contact damping's sign flipped "
+      "(N = K delta^p (1 - chi delta'))", "N_law = N_el * (1.0 + self.cs.chi * dd)",
+      "N_law = N_el * (1.0 - self.cs.chi * dd)", ("tests/test_real_bearing_core.py",)),
+    M("B2", "real bearing: compliant law", "chi from the closing speed without the floor "
+      "(a slow closure undamped)", "chi = self._c_d / max(rdot, V_FLOOR)",
+      "chi = self._c_d / max(rdot, 1e-300)", ("tests/test_real_bearing_core.py",)),
+    M("B3", "real bearing: contact forces", "the contact's torque on the spin loses its lever "
+      "B (the imbalance's)", "dOm = dOm0 - (B * N + A * Ft) * iJ",
+      "dOm = dOm0 - (A * Ft) * iJ", ("tests/test_real_bearing_core.py",)),
+    M("B4", "real bearing: race", "friction does not turn the race in contact",
+      "wbd = wbd0 + R_b * Ft * self.iJb", "wbd = wbd0", ("tests/test_real_bearing_core.py",)),
+    M("B5", "real bearing: race", "the race breaks away at twice its static friction",
+      "if hold and law.R_b * abs(f.F_t) > law.T_b0:",
+      "if hold and law.R_b * abs(f.F_t) > 2.0 * law.T_b0:",
+      ("tests/test_real_bearing_core.py",)),
+    M("B6", "real bearing: impulses", "an impulse on the sprung race moves it twice as much",
+      "self.v_b += complex(P_n, P_t) * n / bp.m_b",
+      "self.v_b += 2.0 * complex(P_n, P_t) * n / bp.m_b",
+      ("tests/test_real_bearing_core.py", "tests/test_real_race.py")),
+    M("B7", "real bearing: events", "the midpoint check of the contact's event functions "
+      "removed", "if self._margin(self._hermite(y, f0, y1, f1, Hs, 0.5)) <= 0.0:",
+      "if False:", ("tests/test_real_bearing_core.py",)),
 )
 
 
