@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from typing import Any
 
 import pytest
 from rotortd import restore_core
@@ -141,6 +142,55 @@ def test_rigid_impact_on_a_sprung_race_matches_its_closed_form() -> None:
     assert imp.v_plus.real == pytest.approx(rotor, rel=1e-14)
     assert imp.P_n == pytest.approx(p.m * (v_in - rotor), rel=1e-14)
     assert imp.P_n / bp.m_b == pytest.approx(race, rel=1e-14)  # the race's kick
+
+
+def test_a_dip_of_an_event_function_inside_one_step_is_found() -> None:
+    """segments/bearing_contact.py: the event functions are checked at each accepted step's
+    end and at its midpoint (the state's cubic Hermite interpolant), so a function that dips
+    below 0 and returns inside one step, around its midpoint, is found, and located to 4 ulp
+    of the time. A synthetic event function of the spin angle, (psi - psi_c)^2 - eps^2, with
+    the dip centred on the midpoint of a step of a compliant sliding contact and narrower
+    than a quarter of it: the segment ends where psi = psi_c - eps."""
+    from rotortd.contact.events import LIFT_OFF
+    from rotortd.segments import gbs
+    from rotortd.segments.bearing_contact import BearingContact, BearingModel
+    from rotortd.segments.spin_contact import HeldInputs
+
+    core = _drop_core()
+    while core.mode == 0:
+        core.step(1e-5, None, 0j, 0.0, T_drive=0.0)
+    held = HeldInputs(core.params, core.J, 0.0, 0j, 0.0)
+    y0 = core._bearing_state()
+    seg = BearingContact(held, core._law, core._cstate, y0)
+    grid: list[tuple[float, float, float]] = []  # accepted steps: (u, H, psi at u)
+    real_step = gbs.extrapolated_step
+
+    def spy(sweep: Any, u: float, y: list[float], f0: list[float], H: float,
+            scale: list[float], **kw: Any) -> Any:
+        out = real_step(sweep, u, y, f0, H, scale, **kw)
+        if out[1] <= 1.0 and "k_fixed" not in kw:
+            grid.append((u, H, y[4]))
+        return out
+
+    gbs.extrapolated_step = spy
+    try:
+        seg.run(2e-4)
+    finally:
+        gbs.extrapolated_step = real_step
+    u, H, _ = grid[len(grid) // 2]
+    W = y0[5]  # psi advances at about Omega: the dip placed by time
+    psi_c, eps = y0[4] + W * (u + 0.5 * H), 0.1 * W * H
+
+    class Dip(BearingModel):
+        def events(self, y: list[float], n_slack: float = 0.0) -> list[tuple[Any, float]]:
+            return [*super().events(y, n_slack), (LIFT_OFF, (y[4] - psi_c) ** 2 - eps**2)]
+
+    dip = BearingContact(held, core._law, core._cstate, y0)
+    dip.model = Dip(held, core._law, core._cstate)
+    end = dip.run(2e-4)
+    assert end.event == LIFT_OFF
+    assert end.y[4] == pytest.approx(psi_c - eps, rel=1e-13, abs=1e-12 * W * H)
+    assert u < end.duration < u + H
 
 
 def _energy(core: TouchdownCore) -> float:
