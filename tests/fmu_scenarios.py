@@ -385,6 +385,53 @@ def sc_ranges(fmu: str, cases: dict[str, list[float]]) -> dict[str, Any]:
     return {"results": results}
 
 
+BEARING_OUT = ("omega_b", "x_b", "y_b", "vx_b", "vy_b", "F_sx", "F_sy", "P_fric", "E_fric",
+               "E_drag", "Omega_out", "r_rel", "whirl_rate", "v_rel", "x", "y", "F_n_peak",
+               "F_bx", "F_by", "E_diss")
+
+
+def sc_bearing_match_core(fmu: str, bearing: dict, n: int, h: float) -> dict[str, Any]:
+    """The drop onto the real bearing (docs/model.md §10): the FMU's outputs against the
+    core's own (rotortd.SpinCore with the same BearingParams), every step, bit for bit."""
+    import cmath
+
+    import rotortd  # the module the FMU loaded (shared sys.modules)
+
+    p = rotortd.RotorParams(g=9.81, d=0.9, mu=0.15)
+    W = 184.2
+    Z1 = p.m * p.e_c * W**2 * cmath.exp(1j * p.phi) / (p.k - p.m * W**2 + 1j * p.c * W)
+    V1 = 1j * W * Z1
+    inst = Instance(fmu)
+    inst.init({"g": 9.81, "d": 0.9, "mu": 0.15, "J": 0.04, "integrate_spin": True,
+               "Omega": W, "amb_on": 0.0, "x0": Z1.real, "y0": Z1.imag, "vx0": V1.real,
+               "vy0": V1.imag, **bearing})
+    core = rotortd.SpinCore(p, 0.04, z0=Z1, v0=V1, Omega0=W,
+                            bearing=rotortd.BearingParams(**bearing))
+    mismatches = []
+    E_fric = 0.0
+    for i in range(n):
+        status = inst.step(h)
+        rep = core.step(h, F_ext=0j, amb_on=0.0, T_drive=0.0)
+        race = core.race
+        kin = core.outputs()
+        want = {"omega_b": race.omega_b, "x_b": race.z_b.real, "y_b": race.z_b.imag,
+                "vx_b": race.v_b.real, "vy_b": race.v_b.imag, "F_sx": rep.F_support.real,
+                "F_sy": rep.F_support.imag, "P_fric": rep.P_fric, "E_fric": race.E_fric,
+                "E_drag": race.E_drag, "Omega_out": core.Omega, "r_rel": kin.r_rel,
+                "whirl_rate": kin.whirl_rate, "v_rel": kin.v_rel, "x": kin.x, "y": kin.y,
+                "F_n_peak": rep.F_n_peak, "F_bx": rep.F_contact.real,
+                "F_by": rep.F_contact.imag, "E_diss": core.E_diss}
+        got = dict(zip(BEARING_OUT, inst.slave.getReal([inst.vr[k] for k in BEARING_OUT]),
+                       strict=True))
+        E_fric = got["E_fric"]
+        mismatches += [(i, k, got[k], want[k]) for k in BEARING_OUT if got[k] != want[k]]
+        if status != 0:
+            mismatches.append((i, "status", status, 0))
+            break
+    return {"mismatches": mismatches[:10], "n_mismatch": len(mismatches), "E_fric": E_fric,
+            "omega_b": core.race.omega_b}
+
+
 SCENARIOS: dict[str, Callable[..., dict[str, Any]]] = {
     name[3:]: fn for name, fn in globals().items() if name.startswith("sc_")
 }
