@@ -144,6 +144,18 @@ CASES: dict[str, tuple[str, Callable[[], tuple[int, int]], tuple[int, int | None
                               lambda: _init_case({"start_steady": True, "c": 460.0}),
                               (OK, DISCARD), "cross-parameter constraint: start_steady",
                               "Error"),
+    "bearing_held_spin": ("a real bearing's option without `integrate_spin` "
+                          "(`race_turns = true`)",
+                          lambda: _init_case({"race_turns": True}), (OK, DISCARD),
+                          "cross-parameter constraint: race_turns, support_compliant and "
+                          "contact_compliant need integrate_spin = true", "Error"),
+    "bearing_plastic_compliant": ("a compliant contact with `d = 0` "
+                                  "(`contact_compliant = true`, `integrate_spin = true`)",
+                                  lambda: _init_case({"contact_compliant": True, "d": 0.0,
+                                                      "integrate_spin": True}),
+                                  (OK, DISCARD),
+                                  "cross-parameter constraint: d = 0.0 is refused under the "
+                                  "compliant contact law", "Error"),
     "impact_log_unwritable": ("`impact_log` in a missing directory",
                               lambda: _init_case({"impact_log": BAD_LOG}), (OK, DISCARD),
                               "impact_log = ", "Error"),
