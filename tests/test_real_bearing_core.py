@@ -27,7 +27,7 @@ W0 = 184.2
 ALL_ON = {"race_turns": True, "support_compliant": True, "contact_compliant": True}
 
 
-def _drop_core(**opts: object) -> TouchdownCore:
+def _drop_core(**opts: float) -> TouchdownCore:
     """The issue's drop: the chapter's rotor with gravity, mu 0.15, d 0.9, J = m R^2/2, from
     the levitated whirl at 184.2 rad/s with the bearing failed at t = 0."""
     p = RotorParams(g=9.81, d=0.9, mu=0.15)
@@ -102,6 +102,21 @@ def test_single_compliant_impact_matches_its_closed_form(p_c: float, d: float) -
     tol = 5e-14 if p_c == 1.0 else 1e-11  # delta^{3/2} is not smooth at the contact's ends
     assert v_out == pytest.approx(d * v_in, rel=tol)
     assert rep.impacts == []  # a compliant contact has no impulse
+
+
+def test_the_compliant_damping_follows_a_tunable_d() -> None:
+    """d is tunable: changed before a compliant impact (0.9 -> 0.5), the impact rebounds
+    at the new d v_in (the damping c_d of (10.7) follows it); d = 0 is refused mid-run as
+    at the start, and the core keeps its parameters."""
+    v_in = 0.1
+    core, t_close = _single_impact_core(1.0, 0.9, v_in)
+    core.set_params(core.params.replace(d=0.5))
+    exact = rb.single_impact(core.params.m, v_in, 1e9, 1.0, 0.5)
+    core.step(t_close + 2.0 * exact.T, None, 0j, 0.0, T_drive=0.0)
+    assert -core.v.real == pytest.approx(0.5 * v_in, rel=5e-14)
+    with pytest.raises(CrossParameterError, match=r"d = 0\.0 is refused"):
+        core.set_params(core.params.replace(d=0.0))
+    assert core.params.d == 0.5
 
 
 def test_a_slow_closure_gets_the_floor_damping() -> None:
@@ -231,8 +246,11 @@ def test_energy_balance_closes_over_the_drop(opts: dict[str, bool]) -> None:
     assert heat > 0.0
 
 
-def test_state_round_trip_mid_contact_continues_bit_for_bit() -> None:
-    a = _drop_core()
+@pytest.mark.parametrize("T_b0", [0.02, 0.0])
+def test_state_round_trip_mid_contact_continues_bit_for_bit(T_b0: float) -> None:
+    """Restored mid-contact (the race turning; with T_b0 = 0 a race at rest is not held by
+    static friction), the two cores continue bit for bit."""
+    a = _drop_core(T_b0=T_b0)
     for _ in range(30):  # into the second contact (sliding, the race turning)
         a.step(1e-4, None, 0j, 0.0, T_drive=0.0)
     assert a.mode != 0

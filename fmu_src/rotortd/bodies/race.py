@@ -26,7 +26,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from ..contact.laws import restitution_damping
-from ..limits import LIMITS, CrossParameterError, ParameterError
+from ..limits import LIMITS, CrossParameterError
 from ..params import check_range
 
 _MARGIN = 1e-9
@@ -98,7 +98,7 @@ class BearingParams:
                     " plastic compliant contact has no finite damping); use d in (0, 1], or"
                     " the rigid law")
             if not math.isfinite(restitution_damping(d)):
-                raise ParameterError(
+                raise CrossParameterError(
                     f"d = {d!r} is refused under the compliant contact law: its damping "
                     "c_d of (10.7) (about 1/d) overflows; use d >= 1e-300")
 

@@ -342,7 +342,7 @@ class BearingSteps:
         return {**self._race.record(), "kind": RealRace.KIND,
                 "params": asdict(self._race.bp),
                 "contact": {"s": cs.s, "clamped": cs.clamped, "chi": cs.chi,
-                            "s_b": cs.s_b}}
+                            "race_held": cs.race_held, "s_b": cs.s_b}}
 
     def _restore_bearing(self, rec: dict[str, Any]) -> None:
         """Restore the real bearing from a "bearing" record of ``_bearing_record``
@@ -353,7 +353,7 @@ class BearingSteps:
             race = RealRace.from_record(bp, rec, c_r=self._p.c_r, R=self._p.R)
             c = rec["contact"]
             cs = ContactState(float(c["s"]), bool(c["clamped"]), float(c["chi"]),
-                              race.held, float(c["s_b"]))
+                              bool(c["race_held"]), float(c["s_b"]))
         except (KeyError, TypeError, ValueError) as exc:
             raise ParameterError(f"the state's bearing record is not readable: {exc}") from exc
         self._use_bearing(bp)

@@ -179,7 +179,8 @@ def stop_at_work_bound(rep: StepReport, st: StepContext, exc: Exception, t0: flo
     # a segment that stops for another reason (no a-priori bound of a flight) says so: the
     # message claims the bound only when the step's count passed it
     why = (f"work bound reached: {work.total} > {st.cap} work units" if work.total > st.cap
-           else f"stopped after {work.total} of {st.cap} work units")
+           else f"stopped by the work bound's guard after {work.total} of {st.cap} work "
+                "units")
     rep.status, rep.message = STATUS_WORK_CAP, (
         f"{why}; the core stopped at t = {t0 + s!r} s, {s!r} s into the step of {h!r} s, "
         f"in {where}: {exc}")

@@ -297,7 +297,11 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
             raise ParameterError("c_r is fixed after initialisation; it cannot change mid-run")
         if self._J != INF:
             check_well_posed(params, self._J)
+        if self._race is not None:
+            self._race.bp.check(params.d)  # (d = 0 under the compliant law)
         self._p = params
+        if self._race is not None:
+            self._c_d = self._bearing_c_d()  # the compliant law's damping follows d
         self._set_inputs(*self._inputs)  # rebuilds the models; forgets the proof and the lock
 
     @property
