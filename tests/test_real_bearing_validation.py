@@ -9,6 +9,7 @@ on every machine of this kind); each tolerance is set from it."""
 from __future__ import annotations
 
 import cmath
+import itertools
 
 import pytest
 from rotortd.bodies.race import BearingParams
@@ -190,3 +191,70 @@ def test_angular_momentum_balance_with_the_contact_couple() -> None:
     assert abs(L1 - L0 - couple) <= 1e-9 * scale, (L1 - L0, couple)
     assert abs(L1 - L0) <= peak / race.params.k_c * p.mu * P_n
     assert abs(L1 - L0) > 300.0 * abs(L1 - L0 - couple)  # the couple is 99.8 % of the change
+
+
+# ------------------------------------------------------------------ 3. k_c -> infinity
+
+
+def _drop_states(**opts: object) -> tuple[dict[float, tuple[complex, float, float]],
+                                           list[tuple[float, str]]]:
+    """The issue's drop (gravity, all options on unless ``opts``), stepped at 1e-4 s to
+    6 ms: the state (z, Omega, omega_b) at 2 ms and 6 ms and the transitions."""
+    p = RotorParams(g=9.81, d=0.9, mu=0.15)
+    Z1 = p.m * p.e_c * W0**2 * cmath.exp(1j * p.phi) / (p.k - p.m * W0**2 + 1j * p.c * W0)
+    bp = BearingParams(**{"race_turns": True, "support_compliant": True,
+                          "contact_compliant": True, **opts})
+    core = TouchdownCore(p, J=0.04, z0=Z1, v0=1j * W0 * Z1, Omega0=W0, bearing=bp)
+    race = core.race
+    assert race is not None
+    states, trans = {}, []
+    for i in range(1, 61):
+        rep = core.step(1e-4, None, 0j, 0.0, T_drive=0.0)
+        assert rep.status == 0
+        trans += rep.transitions
+        if i in (20, 60):
+            states[i * 1e-4] = (core.z, core.Omega, race.omega_b)
+    return states, trans
+
+
+def test_compliant_law_converges_to_the_rigid_law() -> None:
+    """The drop under the compliant law (p = 1) at k_c = 1e9 ... 1e12 N/m against the rigid
+    law, state against state at the same time (stepped at 1e-4 s).
+
+    First impact (at 2 ms, after the first contact, which opens at 1.883 ms for 1e9): the
+    differences in Omega are 2.438e-3, 5.817e-4, 1.694e-4, 5.222e-5 rad/s, in omega_b 0.4841,
+    0.1155, 0.03365, 0.01037 rad/s, in z 1.914e-4, 5.804e-5, 1.829e-5, 5.784e-6 c_r: falling
+    4.19, 3.43, 3.24 per decade in Omega and omega_b (the reference's figures, docs/model.md
+    §10: 3.2-4.2), 3.30, 3.17, 3.16 in z, the k_c^(-1/2) = 3.16 of the contact time. At
+    k_c = 1e8 the first contact does not open before the catch-up (4.765 ms): not yet the
+    impact limit (1.66 per decade from 1e8 to 1e9).
+
+    Entry into sustained contact. The two laws differ here in the limit in how, not where,
+    the bouncing ends: the rigid law's impact sequence (123 impacts) ends by the low-speed
+    rule (docs/model.md §6) in sliding at 3.0847 ms; the compliant law bounces 2, 6, 13, 22
+    times (lift-offs before the catch-up at 1e9 ... 1e12), each bounce shorter, and settles
+    later. The race then catches up (first sticking) at 4.43799, 4.40805, 4.40772,
+    4.40858 ms against the rigid law's 4.40913 ms (1.08e-6, 1.41e-6, 5.5e-7 s off from 1e10 on, not
+    monotone). At 6 ms (rolling on the race under both laws) the differences still fall: in
+    Omega 1.516e-4, 5.626e-5, 1.848e-5, 6.070e-6 rad/s (2.69, 3.04, 3.04 per decade), in
+    omega_b 1.380e-2, 3.268e-3, 1.676e-3, 6.074e-4 rad/s (4.22, 1.95, 2.76), in z 6.632e-3,
+    7.300e-4, 1.957e-4, 6.616e-5 c_r (9.08, 3.73, 2.96): no floor down to 6e-6 rad/s, but
+    the rate is no longer the clean k_c^(-1/2) of one impact."""
+    rig, rig_trans = _drop_states(contact_compliant=False)
+    assert rig_trans[0][1] == "sliding" and 3.08e-3 < rig_trans[0][0] < 3.09e-3
+    t_rig = next(t for t, m in rig_trans if m == "rolling")
+    diffs: dict[float, list[tuple[float, float, float]]] = {2e-3: [], 6e-3: []}
+    for kc in (1e9, 1e10, 1e11, 1e12):
+        st, trans = _drop_states(k_c=kc)
+        t_roll = next(t for t, m in trans if m == "rolling")
+        assert abs(t_roll - t_rig) <= (3e-5 if kc == 1e9 else 1.5e-6)
+        for T, out in diffs.items():
+            (z, W, wb), (z0, W0_, wb0) = st[T], rig[T]
+            out.append((abs(W - W0_), abs(wb - wb0), abs(z - z0) / 0.7e-3))
+    rates = {T: [tuple(a / b for a, b in zip(x, y, strict=True))
+                 for x, y in itertools.pairwise(d)] for T, d in diffs.items()}
+    for W_rate, wb_rate, z_rate in rates[2e-3]:
+        assert 3.2 <= W_rate <= 4.2 and 3.2 <= wb_rate <= 4.2
+        assert 3.15 <= z_rate <= 3.31
+    for W_rate, wb_rate, z_rate in rates[6e-3]:
+        assert 2.65 <= W_rate <= 3.05 and 1.9 <= wb_rate <= 4.3 and 2.9 <= z_rate <= 9.1
