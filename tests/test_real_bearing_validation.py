@@ -342,10 +342,9 @@ def test_black_dry_whirl_holds_in_the_core(black_184: dict[str, rb.Whirl]) -> No
 def test_black_dry_whip_holds_in_the_core(black_184: dict[str, rb.Whirl]) -> None:
     """From the stable dry whip (-883.365 rad/s, slip 6.6 m/s) with A perturbed by 1e-3, 3 ms
     (12-25 s of core time, the machine loaded): the core keeps sliding (no transition), the
-    whirl rate oscillating
-    by up to 7e-3 relative at first, decaying at -11 /s; its mean over the last 2 ms is
-    7.7e-5 relative off the steady rate (over 50 ms: -883.384, 2.1e-5; the reference's
-    simulation -883.38)."""
+    whirl rate oscillating by up to 7e-3 relative at first, decaying at -11 /s; its mean over
+    the last 2 ms is 7.7e-5 relative off the steady rate (over 50 ms: -883.384, 2.1e-5; the
+    reference's simulation -883.38)."""
     w = black_184["whip"]
     core = core_on_whirl(w, W0)
     mean, trans = whirl_rate_run(core, 3e-3, 2e-3)
