@@ -122,7 +122,7 @@ def _momentum(core: TouchdownCore) -> tuple[float, list[float]]:
     m Im(conj(z_G) z_G') + J Omega + m_b Im(conj(z_b) z_b') + J_b omega_b."""
     p, race = core.params, core.race
     assert race is not None
-    bp = race.params
+    bp = race.bp
     E = cmath.exp(1j * (core.psi + p.phi))
     zG, vG = core.z + p.e_c * E, core.v + 1j * core.Omega * p.e_c * E
     terms = [p.m * (zG.conjugate() * vG).imag, core.J * core.Omega,
@@ -192,7 +192,7 @@ def test_angular_momentum_balance_with_the_contact_couple() -> None:
     scale = sum(abs(x) for x in terms0 + terms1)
     assert kinds == {"sliding", "rolling", "lift_off"}
     assert abs(L1 - L0 - couple) <= 1e-9 * scale, (L1 - L0, couple)
-    assert abs(L1 - L0) <= peak / race.params.k_c * p.mu * P_n
+    assert abs(L1 - L0) <= peak / race.bp.k_c * p.mu * P_n
     assert abs(L1 - L0) > 300.0 * abs(L1 - L0 - couple)  # the couple is 99.8 % of the change
 
 
@@ -285,8 +285,9 @@ def core_on_whirl(w: rb.Whirl, Omega: float, eps: float = 1e-3) -> TouchdownCore
     st["rotor"]["z"], st["rotor"]["v"] = [A.real, A.imag], [v.real, v.imag]
     b = st["bearing"]
     b["x_b"], b["y_b"], b["vx_b"], b["vy_b"] = w.B.real, w.B.imag, vb.real, vb.imag
-    s = 1.0 if w.kind == "rolling" else math.copysign(1.0, w.vrel)
-    b["contact"] = {"s": s, "clamped": False, "chi": rb.c_d(p.d) / rb.V_FLOOR, "s_b": 1.0}
+    s = 0.0 if w.kind == "rolling" else math.copysign(1.0, w.vrel)  # 0: sticking
+    b["contact"] = {"s": s, "clamped": False, "chi": rb.c_d(p.d) / rb.V_FLOOR,
+                    "race_held": False, "s_b": 1.0}
     st["contact"]["mode"], st["contact"]["slip"] = (2 if w.kind == "rolling" else 1), s
     return restore_core(st)
 
