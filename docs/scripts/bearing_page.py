@@ -2,8 +2,8 @@
 (docs/model.md §10), the same drop with each option off, and the drop-outcome map over the
 race drag T_b0 and the support stiffness k_b.
 
-    PYTHONPATH=fmu_src python docs/scripts/bearing_page.py [--quick] [--map] [--no-drops]
-        [--n-tb 9] [--n-kb 7] [--map-time 0.2] [--workers 1]
+    python docs/scripts/bearing_page.py [--quick] [--map] [--no-drops]
+        [--n-tb 7] [--n-kb 7] [--map-time 0.3] [--workers 1]
 
 Runs the core directly (``rotortd.TouchdownCore`` with ``BearingParams``; faster than the
 FMU, same numbers). The drop: the chapter's rotor with gravity, mu = 0.15, d = 0.9,
@@ -21,14 +21,17 @@ import cmath
 import json
 import math
 import multiprocessing
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rotortd import BearingParams, RotorParams, TouchdownCore
-
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "fmu_src"))
+
+from rotortd import BearingParams, RotorParams, TouchdownCore  # noqa: E402
+
 IMG = ROOT / "docs" / "img"
 W0 = 184.2
 """Spin at the failure (rad/s)."""
@@ -56,6 +59,11 @@ WHIRL_WINDOW = 0.05
 WHIRL_MIN = 2.0 * math.pi / WHIRL_WINDOW
 """|mean whirl rate| (rad/s) above which the map calls the end a whirl: at least one turn
 of the contact point round the bearing in WHIRL_WINDOW (125.7 rad/s)."""
+BACKWARD_SHARE = 0.9
+"""Share of the window's step ends with a negative whirl rate that backward whirl needs."""
+SETTLED_LAG = 0.1
+"""The map's verdict is also taken this many seconds before the end (s): a cell whose two
+verdicts differ is marked unsettled."""
 T_B0 = (0.002, 20.0)
 """Range of the map's race drag (N m, log): up to 20 N m, where the race no longer breaks
 away under the rotor's weight (R_b mu m g = 3.0 N m)."""
@@ -154,6 +162,7 @@ def summary(tr: Trace, window: float) -> dict[str, Any]:
         "whirl_mean": whirl_mean, "whirl_window_s": window,
         "F_n_peak_max": tr.F_n_peak[i_pk], "t_peak": tr.t[i_pk],
         "F_s_max": max(tr.F_s) if tr.F_s else None,
+        "z_b_max_over_c_r": max(abs(z) for z in tr.z_b) / tr.c_r if tr.z_b else None,
         "E_fric_end": tr.E_fric[-1] if tr.E_fric else None,
         "E_drag_end": tr.E_drag[-1] if tr.E_drag else None,
         "last_transition": tr.transitions[-1] if tr.transitions else None,
@@ -261,14 +270,30 @@ def geomspace(lo: float, hi: float, n: int) -> list[float]:
     return [lo * (hi / lo) ** (k / (n - 1)) for k in range(n - 1)] + [hi]
 
 
+def window_verdict(tr: Trace, t_end: float) -> dict[str, Any]:
+    """The map's rule over the WHIRL_WINDOW seconds before ``t_end``: backward whirl when
+    the mean whirl rate is below -WHIRL_MIN (at least one turn backward round the race) and
+    the whirl rate is negative at BACKWARD_SHARE of the step ends (a steady backward whirl,
+    not a rocking swing)."""
+    i1 = round(t_end / H)
+    w = tr.whirl[i1 - round(WHIRL_WINDOW / H):i1]
+    mean = sum(w) / len(w)
+    share = sum(x < 0.0 for x in w) / len(w)
+    return {"whirl_mean": mean, "neg_share": share,
+            "backward": mean < -WHIRL_MIN and share >= BACKWARD_SHARE}
+
+
 def map_cell(args: tuple[float, float, float]) -> dict[str, Any]:
-    """One cell of the map: the drop with T_b0 (N m) and k_b (N/m) for T seconds."""
+    """One cell of the map: the drop with T_b0 (N m) and k_b (N/m) for T seconds; the
+    verdict at T and, as a check that it is settled, at T - SETTLED_LAG."""
     T_b0, k_b, T = args
     tr = run_drop(T, {"T_b0": T_b0, "k_b": k_b}, record=False)
     s = summary(tr, WHIRL_WINDOW)
-    backward = s["whirl_mean"] < -WHIRL_MIN
-    return {"T_b0": T_b0, "k_b": k_b, "backward": backward, "whirl_mean": s["whirl_mean"],
-            "Omega_end": s["Omega_end"], "omega_b_end": s["omega_b_end"],
+    end = window_verdict(tr, T)
+    early = window_verdict(tr, T - SETTLED_LAG) if T - SETTLED_LAG >= WHIRL_WINDOW else end
+    return {"T_b0": T_b0, "k_b": k_b, **end, "backward_early": early["backward"],
+            "whirl_mean_early": early["whirl_mean"], "settled": early["backward"] ==
+            end["backward"], "Omega_end": s["Omega_end"], "omega_b_end": s["omega_b_end"],
             "F_n_peak_max": s["F_n_peak_max"], "first_sticking_s": s["first_sticking_s"],
             "cpu_s": s["cpu_s"]}
 
@@ -279,8 +304,9 @@ def run_map(n_tb: int, n_kb: int, T: float, workers: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     with multiprocessing.get_context("spawn").Pool(max(1, min(workers, 1))) as pool:
         rows = pool.map(map_cell, cells, chunksize=1)
-    return {"n_tb": n_tb, "n_kb": n_kb, "drop_time_s": T, "window_s": WHIRL_WINDOW, "whirl_min": WHIRL_MIN,
-            "wall_s": time.perf_counter() - t0, "cells": rows}
+    return {"n_tb": n_tb, "n_kb": n_kb, "drop_time_s": T, "window_s": WHIRL_WINDOW,
+            "whirl_min": WHIRL_MIN, "backward_share": BACKWARD_SHARE,
+            "settled_lag_s": SETTLED_LAG, "wall_s": time.perf_counter() - t0, "cells": rows}
 
 
 def plot_map(res: dict[str, Any], path: Path) -> None:
@@ -307,13 +333,16 @@ def plot_map(res: dict[str, Any], path: Path) -> None:
     fig.colorbar(m1, ax=ax[1], label="peak load max F_n_peak (kN)")
     for a in ax:
         for r in rows:
-            a.plot(r["T_b0"], r["k_b"], "kx" if r["backward"] else "wo", ms=6, mfc="none")
+            a.plot(r["T_b0"], r["k_b"], "kx" if r["backward"] else "wo", ms=7, mfc="none")
+            if not r["settled"]:
+                a.plot(r["T_b0"], r["k_b"], "ks", ms=12, mfc="none")
         a.plot(DROP_BEARING["T_b0"], DROP_BEARING["k_b"], "k*", ms=12, mfc="gold")
         a.set_xscale("log")
         a.set_yscale("log")
         a.set_xlabel("race drag T_b0, N m")
         a.set_ylabel("support stiffness k_b, N/m")
-    ax[0].set_title("whirl at the end (x: backward, o: not)")
+    ax[0].set_title("whirl at the end (x: backward, o: not; square: verdict changed "
+                    f"in the last {SETTLED_LAG:g} s)", fontsize=9)
     ax[1].set_title("peak contact load over the drop")
     fig.suptitle(f"drop outcome over T_b0 and k_b ({res['drop_time_s']:g} s drops; "
                  "star: the page's drop)")
@@ -328,9 +357,9 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="0.05 s drops, 3 x 3 map of 0.05 s")
     ap.add_argument("--map", action="store_true", help="also the T_b0 x k_b map")
     ap.add_argument("--no-drops", action="store_true", help="skip the drops (with --map)")
-    ap.add_argument("--n-tb", type=int, default=9, help="map cells along T_b0")
+    ap.add_argument("--n-tb", type=int, default=7, help="map cells along T_b0")
     ap.add_argument("--n-kb", type=int, default=7, help="map cells along k_b")
-    ap.add_argument("--map-time", type=float, default=0.2, help="s, each map drop")
+    ap.add_argument("--map-time", type=float, default=0.3, help="s, each map drop")
     ap.add_argument("--workers", type=int, default=1, help="map processes (at most 1)")
     ap.add_argument("--out", type=Path, default=ROOT / "docs",
                     help="directory of the JSON files; images go to its img/")
@@ -356,7 +385,9 @@ def main() -> None:
         res = run_map(n_tb, n_kb, Tm, args.workers)
         for r in res["cells"]:
             print(f"T_b0 {r['T_b0']:.3g} k_b {r['k_b']:.3g}: whirl {r['whirl_mean']:.1f} "
-                  f"backward {r['backward']} peak {r['F_n_peak_max']:.4g} N "
+                  f"neg {r['neg_share']:.2f} backward {r['backward']} (early "
+                  f"{r['whirl_mean_early']:.1f} {r['backward_early']}) "
+                  f"peak {r['F_n_peak_max']:.4g} N "
                   f"Omega {r['Omega_end']:.2f} cpu {r['cpu_s']:.1f} s")
         print(f"map: {n_tb} x {n_kb}, wall {res['wall_s']:.1f} s")
         plot_map(res, img / "bearing_map.png")
