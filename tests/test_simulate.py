@@ -50,6 +50,10 @@ def test_good_run_writes_fmpy_csv_and_exits_0(fmu_path: Path, tmp_path: Path) ->
     (["c_r", "1e-9"], "c_r = 1e-9 m is out of range: it must lie in [1e-06, 0.1] m"),
     (["integrate_spin", "yes"], "integrate_spin = 'yes' is not a Boolean (true, false, 1 or 0)"),
     (["x", "1"], "x is an output (continuous): only parameters and inputs can be set"),
+    (["race_turns", "true"], "race_turns: the real bearing (docs/model.md §10) needs the spin "
+     "as a state: add --start-values integrate_spin true"),
+    (["integrate_spin", "true", "support_compliant", "false", "k_b", "1e8"],
+     "k_b has no effect with support_compliant off"),
 ])
 def test_bad_start_values_exit_2_before_the_run(fmu_path: Path, tmp_path: Path,
                                                 values: list[str], says: str) -> None:

@@ -359,7 +359,7 @@ def test_two_point_drop_sweep_with_J_records_outcomes(tmp_path):
         assert 0.0 < r["Omega_mean"] < r["Omega"] and r["Omega_end"] > 0.0
     assert rows[1]["Omega_mean"] > 2.0 * rows[0]["Omega_mean"]
     meta = sw.read_meta(tmp_path / "d")
-    assert meta["format"] == sw.FORMAT_VERSION == 3 and meta["axes"][0]["log"] is True
+    assert meta["format"] == sw.FORMAT_VERSION == 4 and meta["axes"][0]["log"] is True
 
 
 def test_spin_state_runs_without_drop_and_held_rows_have_no_J():
@@ -453,3 +453,49 @@ def test_sweep_without_its_extra_says_what_to_install() -> None:
                           timeout=60)
     assert proc.returncode == 2, proc.stderr
     assert "dask.distributed, pyarrow" in proc.stderr and '".[sweep]"' in proc.stderr
+
+
+# --------------------------------------------------------------------------- real bearing
+
+BEARING_ON = ["J=0.04", "race_turns=1", "support_compliant=1", "contact_compliant=1"]
+
+
+def test_drop_sweep_over_k_b_with_the_real_bearing(tmp_path, capsys):
+    """rotortd sweep k_b (docs/model.md §10, all three options on): two short drops through
+    the CLI; the rows carry the bearing's parameters, the turning race keeps the spin."""
+    out = tmp_path / "kb"
+    rc = main(["sweep", "k_b=1e7:1e8:log2", *BEARING_ON, "--starts", "drop", "--serial",
+               "--drop-time", "0.02", "--drop-window", "0.01", "--no-progress",
+               "--out", str(out)])
+    assert rc == 0, capsys.readouterr().err
+    rows = sorted(_rows_by_key(out).values(), key=lambda r: r["k_b"])
+    assert [r["k_b"] for r in rows] == [1e7, 1e8]
+    for r in rows:
+        assert r["status"] == "ok" and r["regime"] in sw.DROP_OUTCOMES, r
+        assert (r["race_turns"], r["support_compliant"], r["contact_compliant"]) == (1, 1, 1)
+        assert (r["J_b"], r["k_c"], r["p_c"]) == (2e-4, 1e9, 1.0)  # BearingParams' defaults
+        assert 0.95 * r["Omega"] < r["Omega_end"] < r["Omega"]
+        state = json.loads(r["final_state"])
+        assert state["bearing"]["kind"] != "fixed-rigid"
+    held = sw.run_job(sw.Job(0, (), (("J", 0.04),), "drop"),
+                      sw.Settings(drop_time=0.02, drop_window=0.01))[0]
+    assert math.isnan(held["k_b"]) and math.isnan(held["race_turns"])
+
+
+@pytest.mark.parametrize(
+    ("tokens", "starts", "fragment"),
+    [
+        (["k_b=1e7:1e8:2", "support_compliant=1"], "drop", "needs the spin as a state"),
+        (["J=0.04", "k_b=1e7:1e8:2"], "drop", "k_b has no effect with support_compliant off"),
+        (["J=0.04", "race_turns=0", "T_b0=0.1"], "drop", "T_b0 has no effect"),
+        (["J=0.04", "race_turns=0.5"], "drop", "race_turns: value 0.5 is not 0 or 1"),
+        (["J=0.04", "contact_compliant=1", "p_c=1.6"], "drop", "p_c: value 1.6 is out of range"),
+        (["J=0.04", "support_compliant=1", "k_b=1e2"], "drop", "k_b: value 100.0 is out"),
+        (["J=0.04", "contact_compliant=1", "d=0"], "drop", "d = 0.0 is refused"),
+        (["J=0.04", "race_turns=1"], "rest,up", "not continued"),
+    ],
+)
+def test_grammar_refuses_bad_bearing_specifications(tokens, starts, fragment):
+    with pytest.raises(sw.SweepError) as err:
+        sw.parse_spec(tokens, starts)
+    assert fragment in str(err.value)

@@ -3,6 +3,7 @@
     rotortd plot RESULT.csv|RESULT.npz -o OUT.png [--c-r 0.7e-3]
     rotortd sweep gamma=0.05:0.3:1000 mu=0.15 --starts rest,steady,cycle,large --out S.parquet
     rotortd sweep mu=0.02:0.5:12 J=3.2e-4:1.6:log12 --starts drop --out D.parquet
+    rotortd sweep k_b=1e6:1e9:log4 J=0.04 race_turns=1 support_compliant=1 --starts drop
     rotortd sweep-plot S.parquet -o diagram.png
     rotortd simulate models/RotorTouchdown.fmu --stop-time 0.1 --start-values g 9.81 ...
 
@@ -93,8 +94,12 @@ def _add_sweep_parsers(sub: argparse._SubParsersAction) -> None:
     sw = sub.add_parser(
         "sweep", help="sweep one or two parameters on Dask, attractor signatures to Parquet",
         description="Sweep scaled parameters (gamma omega rho phi mu d R_over_cr) and/or "
-        "Omega (rad/s), J (kg m^2: the spin as a state) and T_drive (N m, needs J); others "
-        "fixed at the chapter set, the spin held when J is not given. SPEC: name=a:b:n "
+        "Omega (rad/s), J (kg m^2: the spin as a state) and T_drive (N m, needs J), and the "
+        "real bearing (docs/model.md §10, docs/bearing.md; needs J, the FMU's integrate_spin "
+        "= true): options race_turns, support_compliant, contact_compliant (0 or 1) and "
+        "their parameters J_b (kg m^2), T_b0 (N m), c_bw (N m s), omega_b0 (rad/s); m_b "
+        "(kg), k_b (N/m), c_b (N s/m); k_c (N/m), p_c (1 to 1.5), each only with its option "
+        "on. Others fixed at the chapter set, the spin held when J is not given. SPEC: name=a:b:n "
         "(grid), name=a:b:logn (geometric grid), name=a:b:~n (sorted random samples) or "
         "name=value (fixed).")
     sw.add_argument("spec", nargs="+",

@@ -8,7 +8,9 @@ It takes ``fmpy simulate``'s options for a run (``--start-values NAME VALUE ...`
 - before simulating, an unknown variable name (with close matches), a variable that cannot
   be set (an output), a value that does not parse for the variable's type (Real, Integer,
   Boolean: true/false/1/0) or lies outside its declared min/max is refused with a message
-  naming the variable, value, unit and range, exit status 2;
+  naming the variable, value, unit and range, exit status 2; so is one of the real bearing's
+  twelve parameters (docs/model.md §10) set without ``integrate_spin = true``, or a parameter
+  of an option left off (``rotortd_tools.bearing_args``);
 - a progress line on stderr every 5 s of wall time (simulated time, stop time, percent),
   at communication points (``ROTORTD_PROGRESS_SECONDS`` sets the interval);
 - exit status 1, with one line saying at what time (the last successful time) and why (the
@@ -36,6 +38,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
+
+from rotortd_tools.bearing_args import bearing_problems
 
 PROGRESS_ENV = "ROTORTD_PROGRESS_SECONDS"
 PROGRESS_SECONDS = 5.0  # wall time between progress lines [s]
@@ -123,8 +127,23 @@ def prepare(args: argparse.Namespace) -> Run:
     for name in output or ():
         if name not in variables:
             raise UsageError(f"--output-variables: {_unknown(name, variables)}")
-    return Run(args.fmu, md, parse_start_values(args.start_values, variables), start, stop,
-               args.output_interval, output, args.output_file)
+    values = parse_start_values(args.start_values, variables)
+    check_bearing(values, variables)
+    return Run(args.fmu, md, values, start, stop, args.output_interval, output,
+               args.output_file)
+
+
+def check_bearing(values: dict[str, Any], variables: dict[str, Any]) -> None:
+    """UsageError when a real-bearing parameter is set without integrate_spin = true (given
+    or the FMU's default), or a parameter with its option off (docs/model.md §10)."""
+    if "integrate_spin" not in variables:
+        return
+    default = str(variables["integrate_spin"].start).strip().lower() in ("true", "1")
+    spin = bool(values.get("integrate_spin", default))
+    problems = bearing_problems(values, spin, "add --start-values integrate_spin true",
+                                "add --start-values {opt} true")
+    if problems:
+        raise UsageError("--start-values: " + "; ".join(problems))
 
 
 def _times(md: Any, start: float | None, stop: float | None) -> tuple[float, float]:

@@ -9,9 +9,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from rotortd_tools.bearing_args import BEARING_NAMES
 from rotortd_tools.sweep.schema import empty_signature
 from rotortd_tools.sweep.signature import simulate, simulate_drop
-from rotortd_tools.sweep.spec import SCALED_NAMES, Settings, point_params, spin_inputs
+from rotortd_tools.sweep.spec import (
+    SCALED_NAMES,
+    Settings,
+    bearing_params,
+    point_params,
+    spin_inputs,
+)
 from rotortd_tools.sweep.starts import NoStart, core_for
 
 
@@ -44,6 +51,8 @@ def base_row(job: Job, settings: Settings) -> dict[str, Any]:
     J, T_drive = spin_inputs(dict(job.values))
     row["J"] = math.nan if J is None else J
     row["T_drive"] = math.nan if J is None else T_drive
+    bp = bearing_params(dict(job.values))
+    row.update({n: math.nan if bp is None else float(getattr(bp, n)) for n in BEARING_NAMES})
     row.update({"transient": settings.transient, "record": settings.record})
     return row
 
@@ -51,14 +60,15 @@ def base_row(job: Job, settings: Settings) -> dict[str, Any]:
 def run_job(job: Job, settings: Settings, state: dict | None = None
             ) -> tuple[dict[str, Any], dict | None]:
     """Run one job (from ``state`` if given, else its start); return (row, final state).
-    With J the core is a SpinCore driven by T_drive; the ``drop`` start runs the drop."""
+    With J the core is a SpinCore driven by T_drive, on the point's real bearing if it has
+    one; the ``drop`` start runs the drop."""
     row = base_row(job, settings)
     t0 = time.process_time()
     p, Omega, sp = point_params(dict(job.values))
     J, T_drive = spin_inputs(dict(job.values))
     T = None if J is None else T_drive
     try:
-        core = core_for(job.start, p, Omega, sp, state, J)
+        core = core_for(job.start, p, Omega, sp, state, J, bearing_params(dict(job.values)))
         run = simulate_drop if job.start == "drop" else simulate
         sig = run(core, Omega, settings, T)
         final = core.get_state() if sig["status"] == "ok" else None

@@ -28,7 +28,8 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("Omega_end", "f8"), ("Omega_mean", "f8"), ("whirl_mean", "f8"), ("slip_mean", "f8"),
     ("slip_ratio", "f8"), ("final_state", "str"), ("cpu_s", "f8"),
 )
-"""Output columns and types (str, int64, float64, list<float64>). Store format 2 added
+"""Output columns and types (str, int64, float64, list<float64>). Store format 4 added the
+real bearing's twelve parameters (options as 1.0/0.0, NaN without a bearing). Format 2 added
 ``J``, ``T_drive`` (parameters, NaN when not given) and ``Omega_end`` (final spin, rad/s),
 ``Omega_mean``, ``whirl_mean`` (rad/s), ``slip_mean`` (m/s), ``slip_ratio`` (the drop's
 window means, NaN for other starts)."""

@@ -3,7 +3,10 @@
 Parameters are the chapter's scaled set (docs/model.md §1: gamma, omega, rho, phi, mu, d,
 R_over_cr) plus the spin speed ``Omega`` in rad/s, and the spin-state inputs ``J`` (polar
 inertia about the mass centre, kg m^2: the run uses ``rotortd.SpinCore``, Omega is then only
-the initial spin) and ``T_drive`` (held drive torque, N m; needs J). A point starts from
+the initial spin) and ``T_drive`` (held drive torque, N m; needs J), and the real bearing's
+twelve parameters (docs/model.md §10, ``rotortd_tools.bearing_args``: the options race_turns,
+support_compliant, contact_compliant as 0/1 and their parameters in SI; they need J, and a
+parameter needs its option on; ``bearing_params``). A point starts from
 the chapter's SI set (``rotortd.scaled.CHAPTER``)
 at ``Omega`` (default 184.2 rad/s), takes its scaled set
 and replaces the fields the sweep names (swept or fixed); it is realised in SI with
@@ -22,14 +25,17 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from rotortd import ParameterError, RotorParams, ScaledParams
+from rotortd import BearingParams, ParameterError, RotorParams, ScaledParams
 from rotortd.bodies.rotor import check_well_posed
+from rotortd.limits import LIMITS
 from rotortd.scaled import CHAPTER_OMEGA, chapter_params, si_params
+
+from rotortd_tools.bearing_args import BEARING_NAMES, OPTIONS, bearing_problems
 
 SCALED_NAMES = ("gamma", "omega", "rho", "phi", "mu", "d", "R_over_cr")
 SPIN_NAMES = ("J", "T_drive")
 """The spin-state inputs: J (kg m^2, selects ``SpinCore``) and T_drive (N m, needs J)."""
-PARAM_NAMES = (*SCALED_NAMES, "Omega", *SPIN_NAMES)
+PARAM_NAMES = (*SCALED_NAMES, "Omega", *SPIN_NAMES, *BEARING_NAMES)
 ALIASES = {"R/c_r": "R_over_cr", "R/cr": "R_over_cr", "Rcr": "R_over_cr", "W": "Omega"}
 RANGES: dict[str, tuple[float | None, float | None, bool]] = {
     "gamma": (0.0, None, False),
@@ -42,6 +48,8 @@ RANGES: dict[str, tuple[float | None, float | None, bool]] = {
     "Omega": (0.0, None, True),
     "J": (0.0, None, True),
     "T_drive": (None, None, False),
+    **{n: (0.0, 1.0, False) for n in OPTIONS},
+    **{n: (LIMITS[n].lo, LIMITS[n].hi, False) for n in BEARING_NAMES if n not in OPTIONS},
 }
 """(lo, hi, lo_open) of each parameter; None means unbounded."""
 SIMPLE_STARTS = ("rest", "steady", "large", "cycle", "drop")
@@ -161,6 +169,8 @@ def check_value(name: str, value: float, what: str = "value") -> float:
         lo_s = "-inf" if lo is None else f"{lo:g}"
         hi_s = "inf)" if hi is None else f"{hi:g}]"
         raise SweepError(f"{name}: {what} {value!r} is out of range {left}{lo_s}, {hi_s}")
+    if name in OPTIONS and value not in (0.0, 1.0):
+        raise SweepError(f"{name}: {what} {value!r} is not 0 or 1 (an option: off or on)")
     return value
 
 
@@ -272,10 +282,27 @@ def parse_spec(tokens: Sequence[str], starts: str | Sequence[str] = "rest",
     if "T_drive" in seen and "J" not in seen:
         raise SweepError("T_drive needs J: with the spin held (no J) a drive torque has no "
                          "effect; give J=... to make the spin a state")
+    _check_bearing_names(fixed, {a.name for a in axes}, "J" in seen)
     spec = SweepSpec(tuple(axes), tuple(sorted(fixed.items())), parse_starts(starts), seed)
+    if any(n in seen for n in BEARING_NAMES) and any(
+            s.partition(":")[0] in CONTINUATION for s in spec.starts):
+        raise SweepError("the real bearing's parameters are not continued (up/down): a "
+                         "continued state would keep the previous point's bearing; use "
+                         "independent starts (rest, steady, large, drop)")
     _check_realisable(spec)
     _check_cycle_available(spec.starts)
     return spec
+
+
+def _check_bearing_names(fixed: dict[str, float], swept: set[str], has_J: bool) -> None:
+    """SweepError when a bearing parameter is given without J or with its option off."""
+    given: dict[str, object] = {n: fixed[n] for n in BEARING_NAMES if n in fixed}
+    given.update({n: None for n in BEARING_NAMES if n in swept})  # swept: on somewhere
+    problems = bearing_problems(
+        given, has_J, "give J=... (kg m^2; the FMU's integrate_spin = true)",
+        "give {opt}=1")
+    if problems:
+        raise SweepError("; ".join(problems))
 
 
 def _check_realisable(spec: SweepSpec) -> None:
@@ -290,6 +317,9 @@ def _check_realisable(spec: SweepSpec) -> None:
             J = spin_inputs(values)[0]
             if J is not None:
                 check_well_posed(p, J)
+            bp = bearing_params(values)
+            if bp is not None:
+                bp.check(p.d)
         except ParameterError as exc:
             raise SweepError(f"parameters {values} cannot be realised: {exc}") from None
 
@@ -324,6 +354,17 @@ def spin_inputs(values: dict[str, float]) -> tuple[float | None, float]:
     """(J in kg m^2 or None for the held spin, T_drive in N m) of a point."""
     J = values.get("J")
     return (None if J is None else float(J)), float(values.get("T_drive", 0.0))
+
+
+def bearing_params(values: dict[str, float]) -> BearingParams | None:
+    """The real bearing of a point (``BearingParams``: the given names, the others at their
+    defaults, options off unless given), or None when no bearing name is given (the
+    chapter's fixed rigid bearing)."""
+    given = {n: values[n] for n in BEARING_NAMES if n in values}
+    if not given:
+        return None
+    return BearingParams(**{n: (bool(v) if n in OPTIONS else float(v))
+                            for n, v in given.items()})
 
 
 def drop_params(p: RotorParams) -> RotorParams:

@@ -17,14 +17,22 @@ for the core:
                   (rest by default). One chain per value of the second parameter.
 
 With J (kg m^2) every start is the same state in a ``SpinCore`` of that inertia, spinning
-at Omega (rad/s); a continued state takes the point's J.
+at Omega (rad/s), on the point's real bearing when it has one (docs/model.md §10, the race
+centred and at rest unless omega_b0 says otherwise); a continued state takes the point's J.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-from rotortd import ParameterError, RotorParams, ScaledParams, SpinCore, TouchdownCore
+from rotortd import (
+    BearingParams,
+    ParameterError,
+    RotorParams,
+    ScaledParams,
+    SpinCore,
+    TouchdownCore,
+)
 from rotortd.scaled import regular_equilibrium
 from rotortd.step.state import CoreState
 
@@ -42,13 +50,18 @@ class NoStart(RuntimeError):
 
 
 def make_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams,
-               J: float | None = None) -> TouchdownCore:
+               J: float | None = None, bearing: BearingParams | None = None
+               ) -> TouchdownCore:
     """A core at the named simple start (rest, steady, large, cycle[:BRANCH], drop); with
-    J (kg m^2) the same state in a SpinCore spinning at Omega (rad/s)."""
+    J (kg m^2) the same state in a SpinCore spinning at Omega (rad/s), on ``bearing`` (the
+    real bearing; it needs J) when given."""
     core = _held_start(label, p, Omega, sp)
     if J is None:
+        if bearing is not None:
+            raise SweepError("the real bearing's parameters need J (the spin as a state)")
         return core
-    return SpinCore(core.params, J, z0=core.z, v0=core.v, psi0=core.psi, Omega0=Omega, t0=core.t)
+    return SpinCore(core.params, J, z0=core.z, v0=core.v, psi0=core.psi, Omega0=Omega,
+                    t0=core.t, bearing=bearing)
 
 
 def _held_start(label: str, p: RotorParams, Omega: float, sp: ScaledParams
@@ -88,9 +101,10 @@ def _cycle_start(p: RotorParams, Omega: float, sp: ScaledParams, branch: str) ->
 
 
 def core_for(start: str, p: RotorParams, Omega: float, sp: ScaledParams,
-             state: dict | None, J: float | None = None) -> TouchdownCore:
+             state: dict | None, J: float | None = None,
+             bearing: BearingParams | None = None) -> TouchdownCore:
     """A core at the start, or continued from ``state`` with the point's parameters (and
-    its J, kg m^2, when given: a SpinCore)."""
+    its J, kg m^2, when given: a SpinCore; the real ``bearing`` only at a simple start)."""
     head, _, seed = start.partition(":")
     if head in CONTINUATION:
         if state is None:
@@ -103,6 +117,6 @@ def core_for(start: str, p: RotorParams, Omega: float, sp: ScaledParams,
             core.set_state(replace(CoreState.from_json(state), J=J))
         core.set_params(p)
         return core
-    return make_start(start, p, Omega, sp, J)
+    return make_start(start, p, Omega, sp, J, bearing)
 
 

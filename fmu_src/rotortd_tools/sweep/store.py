@@ -15,8 +15,10 @@ from rotortd_tools.sweep.schema import arrow_schema
 from rotortd_tools.sweep.spec import Settings, SweepError, SweepSpec
 
 META_FILE = "_sweep.json"
-FORMAT_VERSION = 3  # 3: the drop outcomes named as the literature does (dry-whirl, dry-whip)
-"""Store format: 2 added the columns J, T_drive, Omega_end, Omega_mean, whirl_mean,
+FORMAT_VERSION = 4  # 4: the real bearing's twelve parameter columns (docs/model.md §10)
+"""Store format: 4 added the real bearing's twelve parameters (race_turns ... p_c, NaN when
+no bearing name is given); 3 named the drop outcomes as the literature does (dry-whirl,
+dry-whip); 2 added the columns J, T_drive, Omega_end, Omega_mean, whirl_mean,
 slip_mean, slip_ratio and the drop settings. A format-1 store is still read (``read_sweep``,
 ``rotortd sweep-plot``) but is not resumed."""
 
@@ -123,7 +125,8 @@ def prepare_output(path: Path, spec: SweepSpec, settings: Settings, overwrite: b
             "Omega_mean, whirl_mean, slip_mean, slip_ratio; format 3 renamed the regime "
             "whip and the drop outcome dry-whip (both rolling) to dry-whirl and the drop "
             "outcome backward-whirl (sliding) to dry-whip, as the rotordynamics literature "
-            "names them): it can still be read "
+            "names them; format 4 added the real bearing's parameters race_turns ... p_c): "
+            "it can still be read "
             "(read_sweep, sweep-plot) but not resumed; use --overwrite or another --out"
         )
     if old is not None:
