@@ -444,28 +444,36 @@ class BearingContact:
     def _peak_in_step(self, sweep: Callable[..., Vector], u: float, y: Vector, f0: Vector,
                       y1: Vector, Hs: float, k: int, scale: Vector) -> tuple[float, int]:
         """(the largest N in the accepted step, work): the ends' N, and under the compliant
-        law the N at the located zero of N' where N' turns from positive to not positive in
-        the step (Illinois on the step re-integrated with k columns, to 4 ulp of the time).
-        A step is at most a radian of the contact's natural frequency, so N has at most one
-        interior maximum in it."""
+        law, where N' turns from positive to not positive in the step, the peak bracketed
+        by Illinois on N' (the step re-integrated with k columns). A step is at most a
+        radian of the contact's natural frequency, so N has at most one interior maximum
+        in it, where N' decreases: on a bracket [a, b] of it, N(a) + (b - a) N'(a) and
+        N(b) - (b - a) N'(b) both bound the peak from above. The search stops once the
+        smaller of the two excesses, (b - a) min(N'(a), -N'(b)), is at most RTOL of the
+        larger end value, which it returns (or at 4 ulp of the time)."""
         model = self.model
         fa, fb = model.forces(y), model.forces(y1)
         peak = max(fa.N, fb.N)
         if not (fa.dN > 0.0 >= fb.dN):
             return peak, 0
         work = 0
+        seen = {0.0: (fa.dN, fa.N), Hs: (fb.dN, fb.N)}
 
         def at(tau: float) -> tuple[float, float]:
             nonlocal work
             yt, _, _, nfev = gbs.extrapolated_step(sweep, u, y, f0, tau, scale, k_fixed=k)
             work += RHS_WORK * nfev + STEP_WORK
             ft = model.forces(yt)
+            seen[tau] = ft.dN, ft.N
             return ft.dN, ft.N
 
-        _, _, N_top = illinois(at, 0.0, fa.dN, Hs, fb.dN, fb.N,
-                               lambda a, b, fb: b - a <= 4.0 * math.ulp(u + b) or fb == 0.0,
-                               ROOT_ITERS)
-        return max(peak, N_top), work
+        def narrow(a: float, b: float, _fb: float) -> bool:
+            (dNa, Na), (dNb, Nb) = seen[a], seen[b]
+            return (b - a) * min(dNa, -dNb) <= RTOL * max(Na, Nb) \
+                or b - a <= 4.0 * math.ulp(u + b) or dNb == 0.0
+
+        a, b, _ = illinois(at, 0.0, fa.dN, Hs, fb.dN, fb.N, narrow, ROOT_ITERS)
+        return max(peak, seen[a][1], seen[b][1]), work
 
     @staticmethod
     def _hermite(y: Vector, f0: Vector, y1: Vector, f1: Vector, Hs: float, x: float
