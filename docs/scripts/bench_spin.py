@@ -28,6 +28,10 @@
    k_c = 1e9 N/m; mu = 0.15, d = 0.9), 3000 steps of 1e-4 s through simulate_fmu, against
    the floor FMU (issue 24's target: at most 10x), and the FMU's CPU per simulated second
    over the first 0.1 s at k_c = 1e8 ... 1e11 N/m (docs/img/bearing_cost_kc.png).
+5. Timed (``--speeds``): the drop of 1. from the levitated whirl at Omega0 = 184.2, 1000
+   and 3000 rad/s (issue 26 item 4: at most 5x the floor at every speed), FMU against the
+   floor, the median of --repeats pair ratios (alternating), and CPU per simulated second
+   against Omega0 (docs/img/dry_whirl_drop_speeds.png).
 Writes docs/bench_spin.json; docs/benchmarks.md quotes it.
 """
 
@@ -139,23 +143,81 @@ def quiet_fmu_steps() -> dict[str, Any]:
     return out
 
 
-def drop_start_values() -> dict[str, Any]:
-    """FMU start values of the drop: the levitated whirl's state, bearing failed."""
-    held = TouchdownCore.on_steady_whirl(P, OMEGA0)
-    return {"g": P.g, "integrate_spin": True, "J": J_HALF, "Omega": OMEGA0, "amb_on": 0.0,
+def drop_start_values(omega0: float = OMEGA0) -> dict[str, Any]:
+    """FMU start values of the drop: the levitated whirl's state at omega0 (rad/s), bearing
+    failed."""
+    held = TouchdownCore.on_steady_whirl(P, omega0)
+    return {"g": P.g, "integrate_spin": True, "J": J_HALF, "Omega": omega0, "amb_on": 0.0,
             "x0": held.z.real, "y0": held.z.imag, "vx0": held.v.real, "vy0": held.v.imag}
 
 
-def simulate(fmu: tuple[str, Any]) -> tuple[float, np.ndarray]:
-    """CPU seconds of one simulate_fmu run of the drop, and its output rows."""
+def simulate(fmu: tuple[str, Any], omega0: float = OMEGA0) -> tuple[float, np.ndarray]:
+    """CPU seconds of one simulate_fmu run of the drop from omega0 (rad/s), and its rows."""
     from fmpy import simulate_fmu
 
     unzip, md = fmu
     t0 = time.process_time()
     res = simulate_fmu(unzip, validate=False, model_description=md, stop_time=T_END,
-                       output_interval=H, start_values=drop_start_values(),
+                       output_interval=H, start_values=drop_start_values(omega0),
                        output=[*B.ALL_OUT, "Omega_out"])
     return time.process_time() - t0, res
+
+
+SPEEDS = (184.2, 1000.0, 3000.0)
+"""Issue 26's drop speeds Omega0 (rad/s)."""
+
+
+def timed_speeds(repeats: int) -> dict[str, Any]:
+    """Issue 26 item 4: the drop into dry whirl from the levitated whirl at each of SPEEDS,
+    FMU against the floor (median of ``repeats`` pair ratios, alternating), with the
+    fraction of steps in rolling."""
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        fmus = B.build_fmus(Path(tmp))
+        fmu, floor = fmus["RotorTouchdown"], fmus["RotorTouchdownFloor"]
+        for w in SPEEDS:
+            t_fmu, t_floor = [], []
+            for _ in range(repeats):
+                cpu, res = simulate(fmu, w)
+                t_fmu.append(cpu)
+                t_floor.append(simulate(floor, w)[0])
+            ratio = statistics.median(a / b for a, b in zip(t_fmu, t_floor))
+            rolling = float(np.mean(res["mode"] == 2))
+            out[f"{w:g}"] = {"fmu_cpu_s": t_fmu, "floor_cpu_s": t_floor, "ratio": ratio,
+                             "fmu_cpu_per_simulated_s": statistics.median(t_fmu) / T_END,
+                             "floor_cpu_per_simulated_s": statistics.median(t_floor) / T_END,
+                             "rolling_fraction": rolling,
+                             "Omega_end": float(res["Omega_out"][-1])}
+            print(f"drop into dry whirl from Omega0 = {w:g} rad/s: FMU "
+                  f"{statistics.median(t_fmu):.3f} s CPU, floor "
+                  f"{statistics.median(t_floor):.3f} s, FMU/floor {ratio:.2f} (issue 26's "
+                  f"target <= 5); rolling in {rolling:.0%} of the steps, Omega at "
+                  f"{T_END:g} s {out[f'{w:g}']['Omega_end']:.1f} rad/s", flush=True)
+    return out
+
+
+def plot_speeds(out: dict[str, Any]) -> Path:
+    """docs/img/dry_whirl_drop_speeds.png: CPU per simulated second against Omega0."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ws = [float(w) for w in out]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog(ws, [r["fmu_cpu_per_simulated_s"] for r in out.values()], "o-",
+              label="RotorTouchdown, the drop into dry whirl")
+    floor = [r["floor_cpu_per_simulated_s"] for r in out.values()]
+    ax.loglog(ws, floor, "s--", color="grey", label="floor FMU")
+    ax.loglog(ws, [5 * f for f in floor], ":", color="grey", label="5 x floor (issue 26's target)")
+    ax.set_xlabel("rotor speed at the drop, Omega0 [rad/s]")
+    ax.set_ylabel("CPU seconds per simulated second")
+    ax.set_title(f"{T_END:g} s from the levitated whirl, step {H:g} s, FMPy")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path = B.ROOT / "docs" / "img" / "dry_whirl_drop_speeds.png"
+    fig.savefig(path, dpi=110)
+    return path
 
 
 def timed(repeats: int) -> dict[str, Any]:
@@ -276,7 +338,16 @@ def main() -> int:
     ap.add_argument("--bearing", action="store_true",
                     help="only the drop onto the real bearing (4.): FMU against the floor "
                          "and the cost against k_c, into the existing file, ~5 min")
+    ap.add_argument("--speeds", action="store_true",
+                    help="only the drop into dry whirl at Omega0 = 184.2, 1000, 3000 rad/s "
+                         "(issue 26 item 4), FMU against the floor, with its plot, ~5 min")
     args = ap.parse_args()
+    if args.speeds:
+        result = json.loads(OUT.read_text()) if OUT.exists() else {}
+        result["drop_speeds"] = sp = timed_speeds(args.repeats)
+        OUT.write_text(json.dumps(result, indent=1) + "\n")
+        print(f"wrote {OUT.relative_to(B.ROOT)} and {plot_speeds(sp).relative_to(B.ROOT)}")
+        return 0
     if args.bearing:
         result = json.loads(OUT.read_text()) if OUT.exists() else {}
         result["real_bearing"] = rb = timed_bearing(args.repeats)
