@@ -354,3 +354,21 @@ def test_switched_off_the_motion_is_the_same_to_the_bit(gamma: float) -> None:
     assert on.n_impacts > 100 and modes >= {0, 1}
     s_on, s_off = on.get_state(), off.get_state()
     assert s_on["step"].pop("imb_h") != s_off["step"].pop("imb_h") and s_on == s_off
+
+
+def test_a_subnormal_speed_keeps_the_torque_finite() -> None:
+    """FMU fuzz case 1867 (seed 1, docs/fuzz.md): Omega = -5e-324 rad/s held, F_ext about
+    1e12 N, the bearing almost off. The flight's ends formula divides by kappa - Omega^2 +
+    i beta Omega, which is subnormal here, and its K overflowed (then Omega^2 K = 0 * inf
+    = NaN and the FMU refused the step); the closed form takes over where the quotient
+    overflows, and the torque is finite."""
+    p = RotorParams(m=0.6685011154856798, c=80945902.32553299, k=5e-324, e_c=0.0003,
+                    phi=-3.2938560455687836e-05, c_r=0.06132191918747797,
+                    R=0.001000009999, mu=9.999999999999998, d=0.0,
+                    g=1.0327499996655205e-05)
+    core = TouchdownCore(p, z0=complex(0.045605198883090683, -0.022700955271032445),
+                         v0=complex(0.0, -8846.628975671192), psi0=-0.0008119083639846557)
+    rep = core.step(1e-4, -5e-324, complex(-174080569547.08862, 999999999999.9999),
+                    3.137189166289206e-05)
+    assert rep.status == 0 and len(rep.impacts) == 1
+    assert math.isfinite(rep.P_imb) and math.isfinite(rep.T_imb), rep.P_imb

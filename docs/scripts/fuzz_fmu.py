@@ -295,6 +295,14 @@ def draw_roundtrips(rng: random.Random, n_ops: int) -> list[list[Any]]:
     return out
 
 
+BEARING_OPTIONS = ("race_turns", "support_compliant", "contact_compliant")
+"""The real bearing's options (docs/model.md §10): they need integrate_spin."""
+HELD_OPTIONS_KEPT_NOT = 0.9
+"""Share of the cases drawn with a bearing option on and the spin held whose options are
+turned off: the rest test the cross-parameter refusal; without this, 7 in 10 cases were
+refused at the start (docs/fuzz.md, session 13)."""
+
+
 def draw_case(model: ModelInfo, seed: int, index: int) -> dict[str, Any]:
     """Case ``index`` of the stream ``seed`` (the same on every machine and run)."""
     rng = random.Random(f"fuzz-fmu:{seed}:{index}")
@@ -302,6 +310,9 @@ def draw_case(model: ModelInfo, seed: int, index: int) -> dict[str, Any]:
     params = {v.name: draw_value(rng, v, style) for v in model.named("parameter")}
     if set(POSITION) <= params.keys():
         params.update(draw_position(rng, model, params["c_r"]))
+    if (not params.get("integrate_spin") and any(params.get(o) for o in BEARING_OPTIONS)
+            and rng.random() < HELD_OPTIONS_KEPT_NOT):
+        params.update(dict.fromkeys(BEARING_OPTIONS, False))
     params.update({v.name: draw_value(rng, v, style) for v in model.named("input")})
     ops = draw_ops(rng, model, style)
     return {"id": index, "seed": seed, "style": style.name, "params": params, "ops": ops,

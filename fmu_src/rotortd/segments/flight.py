@@ -219,7 +219,9 @@ class FlightModel:
         integrating by parts, K (kappa - Omega^2 + i beta Omega) = f0 int e^{-i Omega u} du
         + F1 E0 s - [z' e^{-i Omega u}]_0^s - (beta + i Omega) [z e^{-i Omega u}]_0^s. Its
         rounding is absolute, about eps (|v| + (beta + |Omega|) |z| + ...)/|den|, however
-        short the flight. The closed form (imb_integral) near resonance (IMB_COND)."""
+        short the flight. The closed form (imb_integral) near resonance (IMB_COND), and
+        where the quotient overflows (a subnormal Omega makes den subnormal while K is
+        finite)."""
         if not self._imb_ends:
             return self.imb_integral(z0, v0, E0, s)
         W = self.Omega
@@ -228,7 +230,8 @@ class FlightModel:
         rhs = self.F1 * E0 * s - (v1 * rot - v0) - complex(self.beta, W) * (z1 * rot - z0)
         if self.f0:
             rhs += self.f0 * (s * dd2(w, 0j))
-        return rhs / self._imb_den
+        K = rhs / self._imb_den
+        return K if cmath.isfinite(K) else self.imb_integral(z0, v0, E0, s)
 
     def imb_impulse_ends(self, z0: complex, v0: complex, E0: complex, z1: complex,
                          v1: complex, s: float) -> float:
