@@ -210,12 +210,19 @@ def plot_speeds(out: dict[str, Any]) -> Path:
     floor = [r["floor_cpu_per_simulated_s"] for r in out.values()]
     ax.loglog(ws, floor, "s--", color="grey", label="floor FMU")
     ax.loglog(ws, [5 * f for f in floor], ":", color="grey", label="5 x floor (issue 26's target)")
-    ax.set_xlabel("rotor speed at the drop, Omega0 [rad/s]")
+    return _save_cost_plot(fig, ax, "rotor speed at the drop, Omega0 [rad/s]",
+                           f"{T_END:g} s from the levitated whirl, step {H:g} s, FMPy",
+                           "dry_whirl_drop_speeds.png")
+
+
+def _save_cost_plot(fig: Any, ax: Any, xlabel: str, title: str, name: str) -> Path:
+    """Label a CPU-per-simulated-second plot and write it to docs/img/name."""
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("CPU seconds per simulated second")
-    ax.set_title(f"{T_END:g} s from the levitated whirl, step {H:g} s, FMPy")
+    ax.set_title(title)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    path = B.ROOT / "docs" / "img" / "dry_whirl_drop_speeds.png"
+    path = B.ROOT / "docs" / "img" / name
     fig.savefig(path, dpi=110)
     return path
 
@@ -306,14 +313,9 @@ def plot_bearing_cost(out: dict[str, Any]) -> Path:
     floor = statistics.median(out["floor_cpu_s"]) / T_END
     ax.axhline(floor, color="grey", ls="--", label="floor FMU")
     ax.axhline(10 * floor, color="grey", ls=":", label="10 x floor (issue 24's target)")
-    ax.set_xlabel("contact stiffness k_c at 10 um [N/m]")
-    ax.set_ylabel("CPU seconds per simulated second")
-    ax.set_title(f"first {out['sweep_span_s']:g} s of the drop, step 1e-4 s, FMPy")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = B.ROOT / "docs" / "img" / "bearing_cost_kc.png"
-    fig.savefig(path, dpi=110)
-    return path
+    return _save_cost_plot(fig, ax, "contact stiffness k_c at 10 um [N/m]",
+                           f"first {out['sweep_span_s']:g} s of the drop, step 1e-4 s, FMPy",
+                           "bearing_cost_kc.png")
 
 
 def instructions() -> dict[str, float]:
@@ -327,6 +329,17 @@ def instructions() -> dict[str, float]:
             out[kind] = BI.per_unit(script, [src, kind], *BI.SPIN_STEPS[kind])
             print(f"{kind:>18}: {out[kind] / 1e3:9.1f} k instructions per 1e-4 s step")
     return out
+
+
+def _into_existing(key: str, measure: Any, plot: Any) -> int:
+    """Only one part of the run: its result into docs/bench_spin.json under ``key`` (the
+    other parts kept), and its plot when it has one."""
+    result = json.loads(OUT.read_text()) if OUT.exists() else {}
+    result[key] = part = measure()
+    OUT.write_text(json.dumps(result, indent=1) + "\n")
+    plotted = f" and {plot(part).relative_to(B.ROOT)}" if plot else ""
+    print(f"wrote {OUT.relative_to(B.ROOT)}{plotted}")
+    return 0
 
 
 def main() -> int:
@@ -343,23 +356,12 @@ def main() -> int:
                          "(issue 26 item 4), FMU against the floor, with its plot, ~5 min")
     args = ap.parse_args()
     if args.speeds:
-        result = json.loads(OUT.read_text()) if OUT.exists() else {}
-        result["drop_speeds"] = sp = timed_speeds(args.repeats)
-        OUT.write_text(json.dumps(result, indent=1) + "\n")
-        print(f"wrote {OUT.relative_to(B.ROOT)} and {plot_speeds(sp).relative_to(B.ROOT)}")
-        return 0
+        return _into_existing("drop_speeds", lambda: timed_speeds(args.repeats), plot_speeds)
     if args.bearing:
-        result = json.loads(OUT.read_text()) if OUT.exists() else {}
-        result["real_bearing"] = rb = timed_bearing(args.repeats)
-        OUT.write_text(json.dumps(result, indent=1) + "\n")
-        print(f"wrote {OUT.relative_to(B.ROOT)} and {plot_bearing_cost(rb).relative_to(B.ROOT)}")
-        return 0
-    if args.quiet_only:  # only the quiet spin-state FMU step, into the existing file
-        result = json.loads(OUT.read_text()) if OUT.exists() else {}
-        result["quiet_fmu_step"] = quiet_fmu_steps()
-        OUT.write_text(json.dumps(result, indent=1) + "\n")
-        print(f"wrote {OUT.relative_to(B.ROOT)}")
-        return 0
+        return _into_existing("real_bearing", lambda: timed_bearing(args.repeats),
+                              plot_bearing_cost)
+    if args.quiet_only:
+        return _into_existing("quiet_fmu_step", quiet_fmu_steps, None)
     result = {"timed": timed(args.repeats)}
     if not args.no_valgrind:
         result["instructions_per_step"] = instructions()
