@@ -163,6 +163,19 @@ def simulate(fmu: tuple[str, Any], omega0: float = OMEGA0) -> tuple[float, np.nd
     return time.process_time() - t0, res
 
 
+def alternate(run: Any, fmu: Any, floor: Any, repeats: int
+              ) -> tuple[list[float], list[float], Any]:
+    """``repeats`` pairs of ``run`` (-> (CPU s, rows)) on the FMU then the floor, alternating
+    so that each pair shares the machine's phase: (FMU CPU s, floor CPU s, the last FMU
+    rows)."""
+    t_fmu, t_floor, res = [], [], None
+    for _ in range(repeats):
+        cpu, res = run(fmu)
+        t_fmu.append(cpu)
+        t_floor.append(run(floor)[0])
+    return t_fmu, t_floor, res
+
+
 SPEEDS = (184.2, 1000.0, 3000.0)
 """Issue 26's drop speeds Omega0 (rad/s)."""
 
@@ -176,11 +189,7 @@ def timed_speeds(repeats: int) -> dict[str, Any]:
         fmus = B.build_fmus(Path(tmp))
         fmu, floor = fmus["RotorTouchdown"], fmus["RotorTouchdownFloor"]
         for w in SPEEDS:
-            t_fmu, t_floor = [], []
-            for _ in range(repeats):
-                cpu, res = simulate(fmu, w)
-                t_fmu.append(cpu)
-                t_floor.append(simulate(floor, w)[0])
+            t_fmu, t_floor, res = alternate(lambda f, w=w: simulate(f, w), fmu, floor, repeats)
             ratio = statistics.median(a / b for a, b in zip(t_fmu, t_floor))
             rolling = float(np.mean(res["mode"] == 2))
             out[f"{w:g}"] = {"fmu_cpu_s": t_fmu, "floor_cpu_s": t_floor, "ratio": ratio,
@@ -231,11 +240,7 @@ def timed(repeats: int) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         fmus = B.build_fmus(Path(tmp))
         fmu, floor = fmus["RotorTouchdown"], fmus["RotorTouchdownFloor"]
-        t_fmu, t_floor = [], []
-        for _ in range(repeats):
-            cpu, res = simulate(fmu)
-            t_fmu.append(cpu)
-            t_floor.append(simulate(floor)[0])
+        t_fmu, t_floor, res = alternate(simulate, fmu, floor, repeats)
     modes = res["mode"]
     first_roll = float(res["time"][int(np.argmax(modes == 2))])
     out = {"fmu_cpu_s": t_fmu, "floor_cpu_s": t_floor,
@@ -278,11 +283,8 @@ def timed_bearing(repeats: int) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         fmus = B.build_fmus(Path(tmp))
         fmu, floor = fmus["RotorTouchdown"], fmus["RotorTouchdownFloor"]
-        t_fmu, t_floor = [], []
-        for _ in range(repeats):
-            cpu, res = simulate_bearing(fmu, T_END, BEARING["k_c"])
-            t_fmu.append(cpu)
-            t_floor.append(simulate_bearing(floor, T_END, BEARING["k_c"])[0])
+        t_fmu, t_floor, res = alternate(
+            lambda f: simulate_bearing(f, T_END, BEARING["k_c"]), fmu, floor, repeats)
         sweep = {}
         for k_c in K_C_SWEEP:
             sweep[f"{k_c:g}"] = simulate_bearing(fmu, T_SWEEP, k_c)[0] / T_SWEEP
