@@ -225,7 +225,7 @@ def plot_speeds(out: dict[str, Any]) -> Path:
 
 
 def _save_cost_plot(fig: Any, ax: Any, xlabel: str, title: str, name: str) -> Path:
-    """Label a CPU-per-simulated-second plot and write it to docs/img/name."""
+    """Label a CPU-per-simulated-second plot; write it as ``name`` in the docs image folder."""
     ax.set_xlabel(xlabel)
     ax.set_ylabel("CPU seconds per simulated second")
     ax.set_title(title)
