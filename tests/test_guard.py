@@ -100,13 +100,16 @@ def test_event_source_output_set_reaches_stderr(capsys: pytest.CaptureFixture[st
 def test_work_bound_stop_reaches_stderr_in_fmpy_simulate(fmu_path: Path,
                                                          tmp_path: Path) -> None:
     """The scene of issue 25: one long step with integrate_spin, the rotor dropped into
-    rolling (100 s: since the dry-whirl accelerator a 10 s step fits the work bound). FMPy
-    still exits 0 with a truncated result (its own behaviour), but stderr now
-    has exactly one line naming the instance, the time reached and the work bound."""
+    rolling (100 s with a drive torque of 0.01 N m: since the dry-whirl accelerator a 10 s
+    step fits the work bound, and without a drive a step of any length on the orbit of
+    segments.dry_whirl_orbit costs the same). FMPy still exits 0 with a truncated result
+    (its own behaviour), but stderr now has exactly one line naming the instance, the time
+    reached and the work bound."""
     out = tmp_path / "wb.csv"
     proc = subprocess.run(
         [sys.executable, "-m", "fmpy", "simulate", str(fmu_path), "--start-values",
-         "integrate_spin", "true", "amb_on", "0", "g", "9.81", "--stop-time", "100",
+         "integrate_spin", "true", "amb_on", "0", "g", "9.81", "T_drive", "0.01",
+         "--stop-time", "100",
          "--output-interval", "100", "--output-file", str(out)],
         capture_output=True, text=True, timeout=300, cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr[-2000:]

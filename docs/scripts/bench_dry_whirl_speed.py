@@ -12,20 +12,22 @@ of the clearance), stepped by ``SpinCore.step`` at 1e-4 s. Per speed:
    steps after 5 warm-up steps, in fresh processes with PYTHONHASHSEED = 0, as
    bench_instructions.py and bench_spin.py count), times 1e4: instructions per simulated
    second of rolling, for
-   - ``fast``: the bearing off (a = 0), the declared accelerator on (``rolling_spin_fast``:
+   - ``orbit``: the bearing off (a = 0), T_drive = 0, the declared accelerators on, as
+     shipped (``dry_whirl_orbit``: the orbit's 2-D Fourier form, kept across steps);
+   - ``panels``: the same with ``SpinContact.follow_orbit`` False (``rolling_spin_fast``:
      the direct panel where theta turns at most BETA_DIRECT rad per step, else
-     Fourier-Levin);
-   - ``levin``: the same with the Fourier-Levin panel at every speed (BETA_DIRECT < 0);
-   - ``old``: the bearing off, the accelerator off (``SpinContact.accelerate = False``:
+     Fourier-Levin; what a drive torque T_drive != 0 takes);
+   - ``levin``: the panels with the Fourier-Levin panel at every speed (BETA_DIRECT < 0);
+   - ``old``: the bearing off, the accelerators off (``SpinContact.accelerate = False``:
      the extrapolation integrator, at most one radian of beta per step);
    - ``damper``: the bearing on (amb_on = 1, c = 1400 N s/m: the energy integral does not
      hold, the integrator runs), for the cost law of that path.
-   Printed with the ratio max/min over the speeds (the issue's target for the kernel: at
-   most 1.5 between 60 and 2000 rad/s) and the exponent of a power law through the first
-   and last speed; ``fast`` and ``levin`` also at 6000 rad/s (not in the ratio).
+   Printed with the ratio max/min over the speeds (the issue's target: at most 1.5 between
+   60 and 2000 rad/s) and the exponent of a power law through the first and last speed;
+   ``orbit``, ``panels`` and ``levin`` also at 6000 rad/s (not in the ratio).
 2. The error of one 1e-4 s step from (theta, psi) = (-1.3, 0.4) against the 40-digit Taylor
-   integration (tests/reference/spin_mp.py), for ``fast`` and ``old``: theta over
-   (1 + its turn), psi over (1 + its turn), Omega relative, the impulses over
+   integration (tests/reference/spin_mp.py), for ``orbit``, ``panels`` and ``old``: theta
+   over (1 + its turn), psi over (1 + its turn), Omega relative, the impulses over
    max(|int N|, N_peak h) (as tests/test_dry_whirl_fast.py).
 Writes docs/bench_dry_whirl_speed.json.
 """
@@ -51,19 +53,22 @@ import bench_instructions as BI  # noqa: E402 (docs/scripts: callgrind helpers)
 OUT = ROOT / "docs" / "bench_dry_whirl_speed.json"
 SPEEDS = (60.0, 200.0, 600.0, 2000.0)
 EXTRA = 6000.0
-"""A further speed for the kernel alone (fast, levin): where its cost stays."""
-KINDS = ("fast", "levin", "old", "damper")
+"""A further speed for the kernels alone (KERNELS): where their cost stays."""
+KINDS = ("orbit", "panels", "levin", "old", "damper")
+KERNELS = ("orbit", "panels", "levin")
 H, WARM, N_SHORT, N_LONG = 1e-4, 5, 10, 60
 
 CHILD = '''
 import cmath, math, sys
 from dataclasses import replace
 sys.path.insert(0, sys.argv[1])
-from rotortd import RotorParams, SpinCore, rolling_spin_fast, spin_contact
+from rotortd import RotorParams, SpinCore
+from rotortd.segments import rolling_spin_fast, spin_contact
 kind, W, n = sys.argv[2], float(sys.argv[3]), int(sys.argv[4])
 p = RotorParams(g=9.81)
 J = 0.5 * p.m * p.R ** 2
-spin_contact.SpinContact.accelerate = kind in ("fast", "levin")
+spin_contact.SpinContact.accelerate = kind in ("orbit", "panels", "levin")
+spin_contact.SpinContact.follow_orbit = kind == "orbit"
 if kind == "levin":
     rolling_spin_fast.BETA_DIRECT = -1.0
 core = SpinCore(p, J, Omega0=W)
@@ -79,22 +84,25 @@ assert core.mode == 2, (kind, W, core.mode)
 
 
 def sanity(W: float, kind: str) -> tuple[int, int]:
-    """(kernel calls that took a segment, calls that declined) over 5 steps (``fast``,
-    ``levin``) in this process."""
+    """(kernel calls that took a segment, calls that declined) over 5 steps of a kernel kind
+    (``KERNELS``) in this process."""
     import cmath
     from dataclasses import replace
 
-    from rotortd import RotorParams, SpinCore, rolling_spin_fast, spin_contact
+    from rotortd import RotorParams, SpinCore
+    from rotortd.segments import rolling_spin_fast, spin_contact
+    from rotortd.segments import dry_whirl_orbit
 
     used = declined = 0
-    orig = rolling_spin_fast.DryWhirl.advance
+    orig_orbit, orig_panel = dry_whirl_orbit.advance, rolling_spin_fast.DryWhirl.advance
 
-    def counted(self: Any, *a: Any, **k: Any) -> Any:
+    def counted(*a: Any, **k: Any) -> Any:
         nonlocal used, declined
-        end = orig(self, *a, **k)
+        out = (orig_orbit if kind == "orbit" else orig_panel)(*a, **k)
+        end = out[0] if kind == "orbit" else out
         used += end is not None
         declined += end is None
-        return end
+        return out
 
     p = RotorParams(g=9.81)
     core = SpinCore(p, 0.5 * p.m * p.R ** 2, Omega0=W)
@@ -103,16 +111,22 @@ def sanity(W: float, kind: str) -> tuple[int, int]:
     core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0,
                            z=p.c_r * nn, v=1j * p.c_r * dth * nn))
     keep = rolling_spin_fast.BETA_DIRECT
-    rolling_spin_fast.DryWhirl.advance = counted  # type: ignore[method-assign]
+    if kind == "orbit":
+        dry_whirl_orbit.advance = counted
+    else:
+        rolling_spin_fast.DryWhirl.advance = counted  # type: ignore[method-assign]
     spin_contact.SpinContact.accelerate = True
+    spin_contact.SpinContact.follow_orbit = kind == "orbit"
     try:
         if kind == "levin":
             rolling_spin_fast.BETA_DIRECT = -1.0
         for _ in range(5):
             core.step(H, amb_on=0.0)
     finally:
-        rolling_spin_fast.DryWhirl.advance = orig  # type: ignore[method-assign]
+        dry_whirl_orbit.advance = orig_orbit
+        rolling_spin_fast.DryWhirl.advance = orig_panel  # type: ignore[method-assign]
         rolling_spin_fast.BETA_DIRECT = keep
+        spin_contact.SpinContact.follow_orbit = True
     return used, declined
 
 
@@ -125,7 +139,7 @@ def count(speeds: tuple[float, ...] = SPEEDS, kinds: tuple[str, ...] = KINDS
         src = str(ROOT / "fmu_src")
         for W in speeds:
             for kind in kinds:
-                if kind in ("fast", "levin"):
+                if kind in KERNELS:
                     used, declined = sanity(W, kind)
                     assert used >= 5 and declined == 0, (W, kind, used, declined)
                 per_step = BI.per_unit(script, [src, kind, repr(W)], N_SHORT, N_LONG)
@@ -150,7 +164,7 @@ def summary(ips: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
 
 def step_errors() -> dict[str, dict[str, dict[str, float]]]:
     """Errors of one 1e-4 s step against the 40-digit reference (module docstring, 2.)."""
-    from rotortd import spin_contact
+    from rotortd.segments import spin_contact
     from rotortd.params import RotorParams
     from rotortd.segments.spin_contact import HeldInputs, SpinContact
 
@@ -161,12 +175,13 @@ def step_errors() -> dict[str, dict[str, dict[str, float]]]:
                                       "g", "levitate")}
     J, th0, psi0 = 0.5 * p.m * p.R ** 2, -1.3, 0.4
     mc = p.m * p.c_r
-    out: dict[str, dict[str, dict[str, float]]] = {"fast": {}, "old": {}}
+    out: dict[str, dict[str, dict[str, float]]] = {"orbit": {}, "panels": {}, "old": {}}
     for W in SPEEDS:
         ref = mp_contact(par, J, 0, th0, 0.0, psi0, W, H, a=0.0)
         for kind in out:
             seg = SpinContact(HeldInputs(p, J, 0.0, 0j, 0.0), 0.0, th0, 0.0, psi0, W)
-            seg.accelerate = kind == "fast"
+            seg.accelerate = kind != "old"
+            seg.follow_orbit = kind == "orbit"
             end = seg.run(H, 10 ** 9)
             tal = end.tally
             assert tal is not None
@@ -196,9 +211,9 @@ def main() -> int:
               tuple(args.quick[0].split(",")))
         return 0
     ips = count()
-    extra = count((EXTRA,), ("fast", "levin"))
+    extra = count((EXTRA,), KERNELS)
     result: dict[str, Any] = {"instructions_per_simulated_s": ips, "summary": summary(ips),
-                              "kernel_at_6000_rad_s": {k: v[f"{EXTRA:g}"]
+                              "kernels_at_6000_rad_s": {k: v[f"{EXTRA:g}"]
                                                        for k, v in extra.items()}}
     if not args.no_errors:
         result["step_error_vs_40_digits"] = step_errors()

@@ -11,6 +11,7 @@ from __future__ import annotations
 import cmath
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from ..params import RotorParams
 from ..segments.divdiff import dd2
@@ -160,3 +161,6 @@ class SegmentEnd:
     """Spin a state: spin speed at the end (rad/s)."""
     work: int = 0
     """Deterministic work units the segment used (events.Work)."""
+    orbit: Any = None
+    """Rolling with the spin a state: the orbit (``segments.dry_whirl_orbit.Orbit``) the
+    segment was advanced on or refused, for the next step; None otherwise."""

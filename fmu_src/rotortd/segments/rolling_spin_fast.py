@@ -292,16 +292,22 @@ class DryWhirl:
                 break
         return u
 
-    def contact_impulse(self, u: float, dur: float, int_n: complex) -> complex:
+    def contact_impulse(self, u: float, dur: float, int_n: complex,
+                        paths: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+                        ) -> complex:
         """int F_c dt (N s) over [0, u] lasting dur (s), from the momentum balance
         m dz_G' = (F1 - i m g - a k z + F_c) dt (a c = 0), z_G' = i Omega (e_c E - R n);
-        int_n = int n dt (s), needed only when a k != 0."""
-        def zg_dot(uu: float) -> complex:
-            _, _, _, om2, th = self._path(uu)
-            E = cmath.exp(1j * (self.psi0 + self.sig * uu + self.phi))
-            return 1j * self.sig * math.sqrt(om2) * (self.e_c * E - self.R * cmath.exp(1j * th))
+        int_n = int n dt (s), needed only when a k != 0; ``paths``: ``_path`` at 0 and u,
+        where the caller has them."""
+        p0, pu = paths if paths is not None else (self._path(0.0), self._path(u))
         G = complex(self.Gx, self.Gy)
-        return self.m * (zg_dot(u) - zg_dot(0.0)) - G * dur + self.akcr * int_n
+        return self.m * (self._zg_dot(u, pu) - self._zg_dot(0.0, p0)) - G * dur + self.akcr * int_n
+
+    def _zg_dot(self, u: float, path: tuple[float, ...]) -> complex:
+        """The mass centre's velocity z_G' (m/s) at u from ``_path(u)``."""
+        om2, th = path[3], path[4]
+        E = cmath.exp(1j * (self.psi0 + self.sig * u + self.phi))
+        return 1j * self.sig * math.sqrt(om2) * (self.e_c * E - self.R * cmath.exp(1j * th))
 
     def _end(self, panel: _DirectPanel | _LevinPanel, u: float, dur: float, work: int,
              step0: float) -> SegmentEnd:

@@ -39,7 +39,7 @@ from ..contact.events import LIFT_OFF, SLIP_START, SLIP_ZERO
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
-from . import gbs, rolling_spin_fast
+from . import dry_whirl_orbit, gbs, rolling_spin_fast
 from .roots import illinois
 
 RTOL = 1e-13
@@ -178,18 +178,42 @@ class SpinContact:
     """Declared accelerator: rolling with the bearing's damper off (a c = 0) is advanced by
     its energy integral (``rolling_spin_fast.DryWhirl``, docs/notes/dry-whirl-quadrature.md)
     where that applies and no event can occur; False: always the integrator below."""
+    follow_orbit = True
+    """Declared accelerator: with T_drive = 0 as well, rolling is advanced on its orbit
+    (``dry_whirl_orbit``: the 2-D Fourier form of the energy integral, kept across steps;
+    docs/notes/dry-whirl-quadrature.md §8); False: the panels of ``DryWhirl`` instead."""
 
     def __init__(self, h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
-                 Omega: float, step0: float = math.inf, n_slack: float = 0.0) -> None:
+                 Omega: float, step0: float = math.inf, n_slack: float = 0.0,
+                 orbit: dry_whirl_orbit.Orbit | None = None) -> None:
         self.h, self.s = h, s
+        self.orbit = orbit  # rolling: the dry whirl orbit of the previous step, if any
         self.n_slack = n_slack  # N (N): lift-off only once N < -n_slack
-        self.model = ContactModel(h)
-        p = h.p
-        self.dth_per_W = -p.R / p.c_r
         self.rolling = s == 0.0
         self.y0: Vector = ([theta, psi, Omega] if self.rolling
                            else [theta, dtheta, psi, Omega])
         self.nq = len(self.y0)
+        self.step0 = step0
+        self.dth_per_W = -h.p.R / h.p.c_r
+        self._start = (theta, dtheta, psi, Omega)
+        self._ready = False
+        if not self._orbit_applies():
+            self._setup()
+
+    def _orbit_applies(self) -> bool:
+        """The orbit (``dry_whirl_orbit``) is tried first: rolling, the accelerators on,
+        a c = 0 and T_drive = 0."""
+        return (self.rolling and self.accelerate and self.follow_orbit
+                and self.h.T_drive == 0.0 and rolling_spin_fast.applies(self.h))
+
+    def _setup(self) -> None:
+        """The contact model, the integrator's step bounds and tolerances (not built where
+        the orbit takes the segment)."""
+        self._ready = True
+        h, step0 = self.h, self.step0
+        theta, dtheta, psi, Omega = self._start
+        self.model = ContactModel(h)
+        p = h.p
         N0 = self._forces(self.y0)[0]
         w = max(abs(dtheta), abs(Omega), abs(dtheta - Omega),
                 math.sqrt(abs(N0) / (p.m * p.c_r)), math.sqrt(p.k / p.m), 1.0)
@@ -240,10 +264,18 @@ class SpinContact:
 
     def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
+        orbit = None  # declared accelerators (docs/notes/dry-whirl-quadrature.md):
+        if self._orbit_applies():  # None = not here
+            fast, orbit = dry_whirl_orbit.advance(self.orbit, self.h, *self.y0, rem, limit,
+                                                  self.step0)
+            if fast is not None:
+                return fast
+        if not self._ready:
+            self._setup()
         if self.rolling and self.accelerate and rolling_spin_fast.applies(self.h):
-            # declared accelerator (docs/notes/dry-whirl-quadrature.md): None = not here
             fast = rolling_spin_fast.DryWhirl(self.h, *self.y0).advance(rem, limit, self.step0)
             if fast is not None:
+                fast.orbit = orbit
                 return fast
         y = self.y0 + [0.0] * 5
         nq = self.nq

@@ -34,6 +34,7 @@ from ..limits import CrossParameterError, start_position
 from ..params import InputError, ParameterError, RotorParams, check_finite, check_range
 from ..scaled import TWO_PI_HI, TWO_PI_LO, to_inertial, wrap_angle
 from ..segments.bearing_contact import ContactState
+from ..segments.dry_whirl_orbit import Orbit, orbit_key
 from ..segments.flight import FlightModel
 from ..segments.rub import RubEquilibrium
 from .bearing_step import BearingSteps
@@ -133,6 +134,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         self._E_diss = 0.0
         self._t_contact = math.nan
         self._slide_step = math.inf
+        self._orbit: Orbit | None = None  # rolling with the spin a state: its dry whirl orbit
         self.imbalance_torque = True
         """Compute the imbalance reaction torque (StepReport.P_imb, T_imb) with the spin
         held. False skips that work (5 to 7 % of the core's instructions in the limit-cycle
@@ -616,6 +618,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
             slip=self._slip, locked=self._locked, on_wall=self._on_wall,
             n_impacts=self._n_impacts, t_last=self._t_last, v_last=self._v_last,
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
+            orbit_energy=(self._orbit.E if self._orbit is not None
+                          and self._mode == MODE_ROLLING else math.nan),
             imb_h=(self._imb_seen_h, self._imb_free_h),
             Omega=self._inputs[0], F_ext=self._inputs[1], amb_on=self._inputs[2],
             bearing=(fixed_bearing_record() if self._race is None
@@ -673,6 +677,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         self._E_diss = cs.E_diss
         self._t_contact = cs.t_contact
         self._slide_step = cs.slide_step
+        self._orbit = (None if math.isnan(cs.orbit_energy) or cs.J is None else Orbit(
+            cs.orbit_energy, orbit_key(cs.params, cs.J, cs.amb_on, cs.F_ext, cs.Omega)))
         self._imb_seen_h = cs.imb_h[0]  # the imbalance closed form's choice continues
         if not math.isnan(cs.imb_h[1]):  # (its coefficients: the same bits again)
             c = self._fm.imb_impulse(cs.imb_h[1])

@@ -134,6 +134,7 @@ class SpinSteps:
         end = SpinFlight(self._p, self._J, held.a, held.F_ext, held.T_drive, self._z, self._v,
                          self._psi, self._inputs[0]).run(rem, st.cap - st.work.total)
         st.work.iters += end.work
+        self._orbit = None  # (a dry whirl orbit ends with the rolling)
         self._z, self._v = end.z, end.v
         self._spin_advance_spin(end)
         if end.event is None:
@@ -262,10 +263,11 @@ class SpinSteps:
         slip = 0.0 if self._mode == MODE_ROLLING else self._slip
         seg = SpinContact(st.held, slip, self._theta, self._dtheta, self._psi,
                           self._inputs[0], self._slide_step,
-                          st.n_slack if s == st.sticky_at else 0.0)
+                          st.n_slack if s == st.sticky_at else 0.0, self._orbit)
         end = seg.run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         self._slide_step = end.next_step
+        self._orbit = end.orbit
         self._end_segment(end, rep, st, 1.0 + 0j)  # (I_z = 0: T_imb from the spin balance)
         return st.later(s, end.duration) if end.duration < rem else h
 

@@ -15,7 +15,9 @@ JSON's repr; a complex number is [re, im])::
      "bearing":  {"kind": "fixed-rigid", ...the counter-body's record()...},
      "contact":  {"mode": 0 flight / 1 sliding / 2 rolling, "theta": rad, "dtheta": rad/s,
                   "slip": +-1 (0 before any contact), "locked": bool, "on_wall": bool,
-                  "t_contact": s or null (NaN), "slide_step": s or null (inf)},
+                  "t_contact": s or null (NaN), "slide_step": s or null (inf),
+                  "orbit_energy": J or null (NaN; optional: a version 3 document
+                  without it reads as null)},
      "counters": {"n_impacts": int, "t_last": s, "v_last": m/s, "E_diss": J},
      "step":     {"F_ext": [N, N], "amb_on": 1, "imb_h": [s or null, s or null]}}
 
@@ -100,6 +102,9 @@ class CoreState:
     holds coefficients for (NaN: none): which of its two roundings the next flight takes."""
     bearing: Mapping[str, Any] = field(default_factory=fixed_bearing_record)
     """The counter-body's record: its ``kind`` and its own state fields."""
+    orbit_energy: float = math.nan
+    """Rolling with the spin a state: the energy (J) of the dry whirl orbit the next step
+    continues on (``segments.dry_whirl_orbit``); NaN: none."""
 
     @property
     def inputs(self) -> tuple[float, complex, float]:
@@ -133,7 +138,7 @@ class CoreState:
         for path, attr, codec in FIELDS:
             node: Any = st
             for part in path.split("."):
-                node = node[part]
+                node = node[part] if part in node or path not in OPTIONAL else None
             kwargs[attr] = codec.load(node)
         return cls(**kwargs)
 
@@ -189,6 +194,7 @@ FIELDS: tuple[tuple[str, str, Codec], ...] = (
     ("contact.on_wall", "on_wall", BOOL),
     ("contact.t_contact", "t_contact", NAN_NULL),
     ("contact.slide_step", "slide_step", INF_NULL),
+    ("contact.orbit_energy", "orbit_energy", NAN_NULL),
     ("counters.n_impacts", "n_impacts", INT),
     ("counters.t_last", "t_last", FLOAT),
     ("counters.v_last", "v_last", FLOAT),
@@ -198,6 +204,9 @@ FIELDS: tuple[tuple[str, str, Codec], ...] = (
     ("step.imb_h", "imb_h", NAN_PAIR),
 )
 """Every leaf of the version 3 JSON: (its path, the CoreState attribute, its codec)."""
+
+OPTIONAL = frozenset({"contact.orbit_energy"})
+"""Leaves a version 3 document may lack (written before they were added): read as null."""
 
 LEGACY_PATHS = {"H": "contact.slide_step"} | {
     path.split(".")[-1]: path for path, _, _ in FIELDS if path.split(".")[-1] != "slide_step"}

@@ -1,0 +1,348 @@
+"""Dry whirl on its orbit: rolling on the fixed rigid race with the bearing's damper off
+(a c = 0) and no drive torque (T_drive = 0), a step at the same cost at any speed
+(docs/notes/dry-whirl-quadrature.md §8).
+
+Frame and units: inertial, SI, as ``rolling_spin_fast`` (whose physics ``DryWhirl`` this
+module uses). With T_drive = 0 the potential V(theta, psi) = -c_r Re(conj(G) n)
++ m g e_c sin(psi + phi) is periodic in psi as well as in theta = psi + phi - beta. The
+energy E = 1/2 I_P(beta) Omega^2 + V is constant, so the integrands of the time,
+F = 1/|Omega| = sqrt(I_P / (2 (E - V))) (s/rad), and of the contact impulse,
+D = (N + i F_t) F (N s/rad), are functions on the torus (beta, psi) fixed by E and the held
+inputs alone: one orbit. With their 2-D Fourier series F = sum F_jl e^{i (j beta + l psi)}
+and on the path beta = beta_s + (1 + rho) sigma u, psi = psi_s + sigma u (u >= 0 the spin
+angle travelled from the step's start, sigma = sign Omega),
+
+    t(u) = F_00 u + 2 Re sum_{j > 0 or (j = 0 < l)} F_jl (e^{i phi_jl(u)} - e^{i phi_jl(0)})
+                                                          / (i sigma w_jl),
+    phi_jl = j beta + l psi,   w_jl = j (1 + rho) + l,
+
+and the same for int D du (all (j, l) != 0) and for int n dt (n F = e^{i phi} sum F_jl
+e^{i ((j - 1) beta + (l + 1) psi)}, secular at (j, l) = (1, -1)): closed forms for any u. The
+coefficients come from an N_BETA x N_PSI grid on the torus (2-D DFT), once per orbit; a step
+is the evaluation of a few such sums (Newton for the step end): its work does not depend on
+the speed or on how many turns beta makes in it. No small divisors: w_jl = 0 only at
+(0, 0) when 1 + rho > K_PSI + 1 (RHO_MIN).
+
+The orbit is kept from step to step while the held inputs and the energy stay: E is part of
+the core's state (``CoreState.orbit_energy``), so that a restored state continues on the
+same coefficients bit for bit; the end state's Omega is taken from E (the integral is exact
+across steps). A state whose energy differs from the orbit's by more than E_MATCH relative
+starts a new orbit.
+
+Errors (estimated, as ``rolling_spin_fast``): the first dropped harmonics, j = +-(K_BETA + 1)
+or l = +-(K_PSI + 1), integrated (each at most 2 |F_jl|/|w_jl| over any path; twice that
+for the tail beyond and the aliasing): at most TOL_PHASE rad of theta (the time error times
+rho |Omega|_max), absolute, for any step; those of D at most TOL_IMPULSE of the step's mean
+impulse (otherwise the step declines). Events: ``DryWhirl._no_event`` over every point of the
+torus and every Omega^2 the energy allows (bounds over the whole orbit): no lift-off and no
+slip start can occur anywhere on an orbit taken, for as long as the inputs hold.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from operator import mul
+from typing import TYPE_CHECKING, Any
+
+from ..contact.wall import ContactTally, SegmentEnd
+from .rolling_spin_fast import SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
+
+if TYPE_CHECKING:
+    from ..params import RotorParams
+    from .spin_contact import HeldInputs
+
+K_BETA = 6
+"""Harmonics in beta kept (|j| <= K_BETA; +-(K_BETA + 1) are the check). (I_P's factor
+sqrt(1 - delta cos beta) alone has harmonics of about (delta/2)^j: 2e-14 of F_00 at j = 6
+for the chapter's rotor, delta = 0.01; the Levin panel's K_MAX = 5 meets its tolerance
+relative to the turn of a panel, this one is absolute.)"""
+K_PSI = 6
+"""Harmonics in psi kept (|l| <= K_PSI; +-(K_PSI + 1) are the check)."""
+N_PSI = 2 * K_PSI + 3
+"""Grid points in psi (odd: the check harmonic is not the Nyquist one)."""
+N_BETA = 2 * K_BETA + 3
+RHO_MIN = 17.0
+"""Least R/c_r: the smallest divisor |w_jl| (j != 0) is then 1 + rho - (K_PSI + 1) >= 11."""
+E_MATCH = 16.0 * 2.0 ** -52
+"""Largest relative difference of a state's energy from the orbit's that continues it (the
+rounding of E recomputed from the end state is a few eps)."""
+EPS_MAX = 0.015
+"""Largest c_r |G| + m g e_c relative to E (the potential's modulation of the integrand) for
+which an orbit is built; at 0.015 the chapter's rotor's series meet the tolerance (25 rad/s),
+at 0.02 they do not."""
+DELTA_MAX = 0.05
+"""Largest 2 m R e_c / (J + m (R^2 + e_c^2)) (I_P's modulation) for which one is built."""
+NEWTON_ITERS = 12
+"""Most Newton iterations of the step end (it converges in 3 to 5)."""
+
+_BG = [2.0 * math.pi * a / N_BETA for a in range(N_BETA)]
+_CB = [math.cos(b) for b in _BG]
+_SB = [math.sin(b) for b in _BG]
+_BETA_ROWS = {j: [cmath.exp(-1j * j * b) / N_BETA for b in _BG]
+              for j in range(-K_BETA - 1, K_BETA + 2)}
+"""_BETA_ROWS[j][a] = e^{-i j beta_a}/N_BETA: the DFT rows in beta."""
+_PSI_ROWS = [[cmath.exp(-1j * jp * 2.0 * math.pi * b / N_PSI) / N_PSI for b in range(N_PSI)]
+             for jp in range(-K_PSI - 1, K_PSI + 2)]
+"""_PSI_ROWS[l + K_PSI + 1][b] = e^{-i l psi_b}/N_PSI: the DFT rows in psi."""
+
+Key = tuple[Any, ...]
+
+
+def orbit_key(p: RotorParams, J: float, a: float, F_ext: complex, Omega: float) -> Key:
+    """What an orbit's coefficients depend on besides E: the rotor, the held inputs (bearing
+    switch a, F_ext (N); T_drive = 0) and the direction of the spin."""
+    return (p, J, a, F_ext, Omega >= 0.0)
+
+
+class Orbit:
+    """The 2-D Fourier coefficients of one orbit (energy ``E`` (J) under ``key``), built
+    on first use (``build``; an orbit restored from a state is built at its next step)."""
+
+    __slots__ = ("A", "B", "C", "E", "built", "d00", "err_d", "err_t", "f00", "kappa",
+                 "key", "n_rows", "n_sec", "ok", "sig", "w_max")
+
+    def __init__(self, E: float, key: Key) -> None:
+        self.E, self.key = E, key
+        self.built = self.ok = False
+
+    def build(self, w: DryWhirl) -> None:
+        """The coefficients from the grid, with ``w``'s constants (the held inputs of key)."""
+        self.built, self.sig = True, w.sig
+        grid = self._grid(w)
+        if grid is None:
+            return
+        fq, dq = grid
+        k1, jp1 = K_BETA + 1, K_PSI + 1
+        F = {(j, jp): sum(map(mul, fq[j], _PSI_ROWS[jp + jp1]))
+             for j in range(0, k1 + 1) for jp in range(-jp1, jp1 + 1)}
+        for (j, jp), v in list(F.items()):
+            F[(-j, -jp)] = v.conjugate()
+        D = {(j, jp): sum(map(mul, dq[j], _PSI_ROWS[jp + jp1]))
+             for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)}
+        rho1, sig = 1.0 + w.rho, w.sig
+        check = [(j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)
+                 if abs(j) == k1 or abs(jp) == jp1]
+        Wmax = math.sqrt(max((2.0 * self.E + 2.0 * _v_bound(w)) / _i_min(w), 0.0))
+        fast = [c for c in check if c[0]]
+        slow = [c for c in check if not c[0]]
+        self.err_t = _dropped(F, fast, slow, rho1)
+        self.err_d = _dropped(D, fast, slow, rho1)
+        self.w_max = Wmax
+        self.ok = all(map(math.isfinite, (*self.err_t, *self.err_d)))
+        self.f00, self.d00 = F[(0, 0)].real, D[(0, 0)]
+        self.n_sec = F[(1, -1)] * cmath.exp(1j * w.phi)
+        self.A = _rows(lambda j, jp: (F[(j, jp)] / (1j * sig * (j * rho1 + jp))
+                                      if j > 0 or (j == 0 and jp > 0) else 0j), 0)[K_BETA:]
+        # (rows j >= 0 only: t's sum runs over j > 0, and j = 0 < l)
+        self.B = _rows(lambda j, jp: (D[(j, jp)] / (1j * sig * (j * rho1 + jp))
+                                      if (j, jp) != (0, 0) else 0j), 0)
+        eph = cmath.exp(1j * w.phi)
+        self.C = _rows(lambda j, jp: (eph * F[(j + 1, jp - 1)] / (1j * sig * (j * rho1 + jp))
+                                      if (j, jp) != (0, 0) and abs(j + 1) <= K_BETA
+                                      and abs(jp - 1) <= K_PSI else 0j), 1)
+        vb = _v_bound(w)
+        self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
+                            + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge))
+                            / (2.0 * self.E - 2.0 * vb))
+
+    def peak_on(self, psi_a: float, psi_b: float) -> float:
+        """The largest |N| (N) on the beta grid of the rows psi_b of the grid that lie
+        within [psi_a, psi_b] (either order) widened by one row each way: the peak of a step
+        in which beta turns through every phase, to the grid's resolution in beta (N's
+        modulation over beta is a few harmonics: the grid's maximum is within about
+        (pi/N_BETA)^2/2 = 2 % of that modulation of the cycle's)."""
+        lo, hi = min(psi_a, psi_b), max(psi_a, psi_b)
+        k0 = math.floor(lo * N_PSI / (2.0 * math.pi))
+        k1 = min(math.floor(hi * N_PSI / (2.0 * math.pi)) + 1, k0 + N_PSI - 1)
+        rows = self.n_rows
+        return max(rows[k % N_PSI] for k in range(k0, k1 + 1))
+
+    def _grid(self, w: DryWhirl
+              ) -> tuple[list[list[complex]], dict[int, list[complex]]] | None:
+        """The DFT in beta of F and D on each psi row of the grid: fq[j][b] for j >= 0 and
+        dq[j][b] for every j (|j| <= K_BETA + 1); None if Omega^2 is not positive
+        everywhere or an event is not excluded on the orbit."""
+        lo, hi = _omega2_bounds(w, self.E)
+        if not (lo > 0.0 and w._no_event(lo, hi)):
+            return None
+        m, e_c, c_r, akcr = w.m, w.e_c, w.c_r, w.akcr
+        cen, Gx, Gy, T0, mge = m * c_r * w.rho * w.rho, w.Gx, w.Gy, w.T, w.mge
+        ip = [w.I0 - w.c2 * c for c in _CB]
+        Bs = [e_c * s for s in _SB]
+        As = [w.R - e_c * c for c in _CB]
+        k1 = K_BETA + 1
+        rows_f = [_BETA_ROWS[k] for k in range(k1 + 1)]
+        rows_d = [_BETA_ROWS[k] for k in range(-k1, k1 + 1)]
+        fq: list[list[complex]] = [[] for _ in rows_f]
+        dq: dict[int, list[complex]] = {k: [] for k in range(-k1, k1 + 1)}
+        self.n_rows: list[float] = []
+        for b in range(N_PSI):
+            a = 2.0 * math.pi * b / N_PSI + w.phi
+            cE, sE = math.cos(a), math.sin(a)
+            base = 2.0 * self.E - 2.0 * mge * sE
+            T = T0 + e_c * (w.F1x * sE - w.F1y * cE)
+            fs, ds, ns = [], [], []
+            for cb, sb, IP, B, A in zip(_CB, _SB, ip, Bs, As):
+                ct, st = cE * cb + sE * sb, sE * cb - cE * sb  # theta = psi + phi - beta
+                g_r, g_i = Gx * ct + Gy * st, Gy * ct - Gx * st  # conj(n) G
+                om2 = (base + 2.0 * c_r * g_r) / IP
+                F = 1.0 / math.sqrt(om2)
+                U = m * e_c * om2
+                rn = g_r - akcr + U * cb + cen * om2
+                Fot = g_i + U * sb
+                dW = (T - akcr * B - B * rn - A * Fot) / IP
+                N = rn + m * B * dW
+                fs.append(F)
+                ns.append(abs(N))
+                ds.append(complex(N * F, (Fot + m * A * dW) * F))
+            self.n_rows.append(max(ns))
+            for q, row in zip(fq, rows_f):
+                q.append(sum(map(mul, fs, row)))
+            for k, row in zip(range(-k1, k1 + 1), rows_d):
+                dq[k].append(sum(map(mul, ds, row)))
+        return fq, dq
+
+
+def _dropped(c: dict[tuple[int, int], complex], fast: list[tuple[int, int]],
+             slow: list[tuple[int, int]], rho1: float) -> tuple[float, float, float]:
+    """The first dropped harmonics of a series c: (sum 2 |c_jl|/|w_jl| and sum |c_jl| over
+    the fast ones, j != 0; sum |c_0l| over the slow ones), so that their integral over du rad
+    of psi is at most min(first, second du) + third du."""
+    return (sum(2.0 * abs(c[k]) / abs(k[0] * rho1 + k[1]) for k in fast),
+            sum(abs(c[k]) for k in fast), sum(abs(c[k]) for k in slow))
+
+
+def _rows(coef: Any, wide: int) -> list[list[complex]]:
+    """Rows j = -K_BETA-wide .. K_BETA+wide over l = -K_PSI-wide .. K_PSI+wide of coef(j, l)
+    (the coefficients of the sums ``_series`` evaluates: the kept harmonics, wide = 0; one
+    more each way for int n dt, wide = 1)."""
+    return [[coef(j, jp) for jp in range(-K_PSI - wide, K_PSI + wide + 1)]
+            for j in range(-K_BETA - wide, K_BETA + wide + 1)]
+
+
+def _v_bound(w: DryWhirl) -> float:
+    """|V| on the orbit is at most this (J): c_r |G| + m g e_c (T_drive = 0)."""
+    return w.c_r * math.hypot(w.Gx, w.Gy) + abs(w.mge)
+
+
+def _i_min(w: DryWhirl) -> float:
+    return w.J + w.m * (w.R - w.e_c) ** 2
+
+
+def _omega2_bounds(w: DryWhirl, E: float) -> tuple[float, float]:
+    """Bounds of Omega^2 over the whole orbit of energy E (rad^2/s^2)."""
+    vb = _v_bound(w)
+    i_max = w.J + w.m * (w.R + w.e_c) ** 2
+    return (2.0 * E - 2.0 * vb) / i_max, (2.0 * E + 2.0 * vb) / _i_min(w)
+
+
+def energy(w: DryWhirl) -> float:
+    """E = 1/2 I_P(beta) Omega^2 + V(theta, psi) (J) at ``w``'s start (T_drive = 0)."""
+    return 0.5 * w.K0 - w.v0 + w.mge * w.sE0
+
+
+def _powers(e: complex, k: int) -> list[complex]:
+    """[e^-k, ..., e^k] for |e| = 1."""
+    pos = [1.0 + 0j]
+    for _ in range(k):
+        pos.append(pos[-1] * e)
+    return [x.conjugate() for x in reversed(pos[1:])] + pos
+
+
+def _series(rows: list[list[complex]], eb: list[complex], ep: list[complex]) -> complex:
+    """sum_jl rows[j][l] e^{i j beta} e^{i l psi} from the power lists of e^{i beta} and
+    e^{i psi} (``_powers``)."""
+    return sum(map(mul, eb, [sum(map(mul, r, ep)) for r in rows]))
+
+
+def advance(prev: Orbit | None, h: HeldInputs, theta: float, psi: float, Omega: float,
+            rem: float, limit: int, step0: float) -> tuple[SegmentEnd | None, Orbit | None]:
+    """Roll rem (s) on the orbit of the state (theta, psi, Omega) under ``h`` (T_drive = 0,
+    a c = 0): (the segment's end, the orbit). The end is None where the method does not
+    apply (the orbit's series do not converge, an event is not excluded, the step is too
+    short for the impulses' tolerance, or the work limit is below its cost): the caller then
+    advances the segment otherwise; the orbit is returned all the same, so that a refused
+    orbit is not rebuilt every step."""
+    w = DryWhirl(h, theta, psi, Omega)
+    if not (rem > 0.0 and w.K0 > 0.0 and math.isfinite(w.K0)) or w.rho < RHO_MIN:
+        return None, prev
+    E = energy(w)
+    key = orbit_key(h.p, h.J, h.a, h.F_ext, Omega)
+    orb, build_work = prev, 0
+    if orb is None or orb.key != key or not (
+            abs(E - orb.E) <= E_MATCH * (0.5 * w.K0 + _v_bound(w))):
+        if _v_bound(w) > EPS_MAX * E or w.c2 > DELTA_MAX * w.I0:
+            return None, None  # (the series would not converge: not worth the grid)
+        orb = Orbit(E, key)
+        build_work = SAMPLE_WORK * N_PSI * N_BETA
+    if not orb.built:
+        orb.build(w)  # (a restored orbit's build is not charged: the run it continues
+        # did not build it either, and the work counts must replay bit for bit)
+    if not orb.ok:
+        return None, None
+    cost = build_work + SAMPLE_WORK * (2 * NEWTON_ITERS + 5)
+    if cost > limit:
+        return None, orb
+    w.K0 = 2.0 * (orb.E - (-w.v0 + w.mge * w.sE0))  # Omega^2 on the path from the orbit's E
+    if not _within_tolerance(orb, w, rem * abs(Omega)):
+        return None, orb
+    return _step(orb, w, theta, psi, rem, cost, step0), orb
+
+
+def _within_tolerance(orb: Orbit, w: DryWhirl, du: float) -> bool:
+    """The dropped harmonics' error over a step of du rad of psi within TOL_PHASE (1 + its
+    turn of theta) rad of theta and TOL_IMPULSE of its mean impulse. Each dropped term
+    integrates to at most |c_jl| min(du, 2/|w_jl|) (``_dropped``)."""
+    a, b, c = orb.err_t
+    e_t = min(a, b * du) + c * du
+    a, b, c = orb.err_d
+    e_d = min(a, b * du) + c * du + w.akcr * e_t
+    return (e_t * w.rho * orb.w_max <= TOL_PHASE * (1.0 + w.rho * du)
+            and e_d <= TOL_IMPULSE * abs(orb.d00) * du)
+
+
+def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: int,
+          step0: float) -> SegmentEnd:
+    """The end of rem (s) of rolling on ``orb`` from (theta, psi) (``w``: its physics, with
+    K0 from the orbit's energy)."""
+    sig, rho1 = w.sig, 1.0 + w.rho
+    b_s = psi + w.phi - theta
+    eb0 = _powers(cmath.exp(1j * b_s), K_BETA + 1)
+    ep0 = _powers(cmath.exp(1j * psi), K_PSI + 1)
+    eb0n, ep0n = eb0[1:-1], ep0[1:-1]  # the kept harmonics' powers
+    s_t0 = _series(orb.A, eb0n[K_BETA:], ep0n)
+
+    def t_of(u: float) -> float:
+        eb = [1.0 + 0j]
+        e1 = cmath.exp(1j * (b_s + rho1 * sig * u))
+        for _ in range(K_BETA):
+            eb.append(eb[-1] * e1)
+        ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI)
+        return orb.f00 * u + 2.0 * (_series(orb.A, eb, ep) - s_t0).real
+
+    u = rem / orb.f00 if rem * abs(w.Omega0) * rho1 > 2.0 * math.pi else rem * abs(w.Omega0)
+    for _ in range(NEWTON_ITERS):  # t' = F = 1/|Omega|; the error after an update of du is
+        du = (t_of(u) - rem) * w._speed(u)  # at most kappa/2 du^2 (kappa >= |F'/F|)
+        u = max(0.0, u - du)
+        if orb.kappa * du * du <= math.ulp(u):
+            break
+    eb = _powers(cmath.exp(1j * (b_s + rho1 * sig * u)), K_BETA + 1)
+    ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI + 1)
+    P = orb.d00 * u + _series(orb.B, eb[1:-1], ep[1:-1]) - _series(orb.B, eb0n, ep0n)
+    int_n = (orb.n_sec * u + _series(orb.C, eb, ep) - _series(orb.C, eb0, ep0)
+             if w.akcr else 0j)
+    start, end = w._path(0.0), w._path(u)
+    Pc = w.contact_impulse(u, rem, int_n, (start, end))
+    _, N, _, om2, th = end
+    peak = max(abs(N), abs(start[1]))
+    if u * rho1 >= 2.0 * math.pi:  # beta has turned through every phase
+        peak = max(peak, orb.peak_on(psi, psi + sig * u))
+    else:
+        peak = max(peak, abs(w._path(0.5 * u)[1]))
+    Om = sig * math.sqrt(om2)
+    mc = w.m * w.c_r  # the tally is per unit m c_r (wall.ContactTally)
+    tally = ContactTally(I_n=P.real / mc, I_c=Pc / mc, I_t=P.imag / mc, I_e=0.0,
+                         peak=peak / mc, work=work)
+    return SegmentEnd(rem, th, -w.rho * Om, None, tally, step0, psi=psi + sig * u, Omega=Om,
+                      work=work, orbit=orb)

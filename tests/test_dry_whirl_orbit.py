@@ -1,0 +1,161 @@
+"""Dry whirl on its orbit (``rotortd.segments.dry_whirl_orbit``, the declared accelerator of
+``SpinContact`` for rolling with a c = 0 and T_drive = 0; docs/notes/dry-whirl-quadrature.md
+§8).
+
+1. Against the 40-digit Taylor integration ``tests.reference.spin_mp.mp_contact`` (no shared
+   code) over one 1e-4 s step of dry whirl of the chapter's rotor at 60 to 2000 rad/s, as
+   ``tests/test_dry_whirl_fast.py`` measures the panels: within 1e-13 of its scales.
+2. Against the extrapolation integrator (``SpinContact`` with ``accelerate`` False) at
+   random rolling states with T_drive = 0 (speeds 60 to 6000 rad/s of both signs, gravity
+   on and off, F_ext up to 2000 N, the bearing off or on with its damper off, J from 0.2 to
+   3 m R^2, steps of 1e-6 to 1e-3 s), each step continuing the previous one's orbit.
+3. The orbit carries over steps and states: the energy stays the same float, a state
+   written mid-orbit and restored continues bit for bit, a state written before the orbit
+   was recorded (no ``orbit_energy``) loads, and the work of a step does not depend on the
+   speed.
+4. It declines where it must: a drive torque, a lift-off not excluded, series that do not
+   converge (a slow rotor).
+"""
+
+from __future__ import annotations
+
+import cmath
+import json
+import math
+import random
+from dataclasses import replace
+
+import pytest
+from rotortd import SpinCore
+from rotortd.params import RotorParams
+from rotortd.segments import dry_whirl_orbit as orbit_mod
+from rotortd.segments.spin_contact import HeldInputs, SpinContact
+
+from tests.test_dry_whirl_fast import (
+    CHAPTER,
+    PSI0,
+    SPEEDS,
+    TH0,
+    TOL,
+    H,
+    J,
+    _errors,
+    _held,
+    _reference,
+)
+
+
+def _advance(h: HeldInputs, th: float, psi: float, W: float, rem: float,
+             prev: orbit_mod.Orbit | None = None):
+    return orbit_mod.advance(prev, h, th, psi, W, rem, 10 ** 9, math.inf)
+
+
+@pytest.mark.parametrize("W", SPEEDS)
+def test_one_step_matches_the_40_digit_reference(W: float) -> None:
+    new, orb = _advance(_held(), TH0, PSI0, W, H)
+    assert new is not None and orb is not None and new.orbit is orb
+    assert new.duration == H and new.event is None
+    ref = _reference(W)
+    mc = CHAPTER["m"] * CHAPTER["c_r"]
+    err = _errors(new, TH0, PSI0, W, ref["theta"], ref["psi"], ref["Omega"], ref["P_n"],
+                  ref["P_t"], ref["P_c"], mc)
+    assert all(v <= TOL for v in err.values()), err
+
+
+def _random_case(rng: random.Random) -> tuple[HeldInputs, float, float, float, float]:
+    W = math.copysign(math.exp(rng.uniform(math.log(60.0), math.log(6000.0))),
+                      rng.choice((1.0, -1.0)))
+    a = rng.choice((0.0, 1.0))
+    p = RotorParams(g=rng.choice((0.0, 9.81)), c=0.0 if a else 1400.0,
+                    levitate=rng.choice((True, False)))
+    F = (complex(rng.uniform(-2e3, 2e3), rng.uniform(-2e3, 2e3)) if rng.random() < 0.5
+         else 0j)
+    h = HeldInputs(p, p.m * p.R ** 2 * rng.uniform(0.2, 3.0), a, F, 0.0)
+    rem = math.exp(rng.uniform(math.log(1e-6), math.log(1e-3)))
+    return h, W, rng.uniform(-4.0, 4.0), rng.uniform(-4.0, 4.0), rem
+
+
+def test_agrees_with_the_integrator_over_steps_on_one_orbit() -> None:
+    """Three steps per case, each continuing the orbit, each against the integrator from the
+    same start state."""
+    rng = random.Random(11)
+    taken, worst = 0, dict.fromkeys(("theta", "psi", "Omega", "P_n", "P_t", "P_c"), 0.0)
+    for _ in range(60):
+        h, W, th, psi, rem = _random_case(rng)
+        prev = None
+        for _ in range(3):
+            new, prev = _advance(h, th, psi, W, rem, prev)
+            if new is None:
+                break
+            taken += 1
+            seg = SpinContact(h, 0.0, th, 0.0, psi, W)
+            seg.accelerate = False
+            old = seg.run(rem, 10 ** 9)
+            assert old.event is None and new.event is None and new.duration == rem
+            mc = h.p.m * h.p.c_r
+            tal = old.tally
+            err = _errors(new, th, psi, W, old.theta, old.psi, old.Omega, mc * tal.I_n,
+                          mc * tal.I_t, mc * tal.I_c, mc)
+            for k, v in err.items():
+                worst[k] = max(worst[k], v)
+            th, psi, W = new.theta, new.psi, new.Omega
+    assert taken >= 150, taken
+    assert all(v <= TOL for v in worst.values()), worst
+
+
+def _rolling_core(W: float, **kw: float) -> SpinCore:
+    """The chapter's rotor (gravity, J = m R^2/2) rolling at the bottom of the clearance."""
+    p = RotorParams(**CHAPTER)
+    core = SpinCore(p, J, Omega0=W)
+    th, dth = -math.pi / 2, -p.R * W / p.c_r
+    n = cmath.exp(1j * th)
+    core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0,
+                           z=p.c_r * n, v=1j * p.c_r * dth * n, **kw))
+    return core
+
+
+def test_the_orbit_carries_over_steps_and_states() -> None:
+    core = _rolling_core(2000.0)
+    energies = set()
+    for _ in range(20):
+        core.step(H, amb_on=0.0)
+        energies.add(core.state.orbit_energy)
+    assert core.mode == 2 and len(energies) == 1 and not math.isnan(energies.pop())
+    doc = json.loads(json.dumps(core.get_state()))
+    assert doc["contact"]["orbit_energy"] is not None
+    run = [core.step(H, amb_on=0.0).work for _ in range(10)]
+    again = _rolling_core(1.0)
+    again.set_state(doc)
+    rerun = [again.step(H, amb_on=0.0).work for _ in range(10)]
+    assert again.get_state() == core.get_state() and rerun == run
+    del doc["contact"]["orbit_energy"]  # a version 3 document written before the orbit
+    older = _rolling_core(1.0)
+    older.set_state(doc)
+    assert math.isnan(older.state.orbit_energy)
+    older.step(H, amb_on=0.0)
+    assert older.mode == 2 and not math.isnan(older.state.orbit_energy)
+
+
+def test_work_does_not_depend_on_the_speed() -> None:
+    works = set()
+    for W in (60.0, 700.0, 2000.0, 6000.0, 2e4):
+        end, _ = _advance(_held(), TH0, PSI0, W, H)
+        assert end is not None and end.duration == H
+        works.add(end.work)
+    assert len(works) == 1, works
+
+
+def test_declines_where_it_must() -> None:
+    p = RotorParams(**CHAPTER)
+    W = 60.0
+    driven = HeldInputs(p, J, 0.0, 0j, 5.0)
+    seg = SpinContact(driven, 0.0, TH0, 0.0, PSI0, W)
+    assert seg.run(H).orbit is None  # T_drive != 0: the panels of rolling_spin_fast
+    cen = p.m * p.c_r * (p.R / p.c_r * W) ** 2
+    n = complex(math.cos(TH0), math.sin(TH0))
+    pulled = HeldInputs(p, J, 0.0, -0.99 * cen * n, 0.0)
+    assert _advance(pulled, TH0, PSI0, W, H) == (None, None)
+    assert _advance(_held(), TH0, PSI0, 8.0, H) == (None, None)  # eps near 0.14: no grid
+    orb = _advance(_held(), TH0, PSI0, W, H)[1]
+    assert orb is not None and orb.ok  # below the work a step needs: declined, the orbit kept
+    assert orbit_mod.advance(orb, _held(), TH0, PSI0, W, H, 10, math.inf) == (None, orb)
