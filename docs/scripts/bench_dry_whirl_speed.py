@@ -90,8 +90,7 @@ def sanity(W: float, kind: str) -> tuple[int, int]:
     from dataclasses import replace
 
     from rotortd import RotorParams, SpinCore
-    from rotortd.segments import rolling_spin_fast, spin_contact
-    from rotortd.segments import dry_whirl_orbit
+    from rotortd.segments import dry_whirl_orbit, rolling_spin_fast, spin_contact
 
     used = declined = 0
     orig_orbit, orig_panel = dry_whirl_orbit.advance, rolling_spin_fast.DryWhirl.advance
@@ -164,8 +163,8 @@ def summary(ips: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
 
 def step_errors() -> dict[str, dict[str, dict[str, float]]]:
     """Errors of one 1e-4 s step against the 40-digit reference (module docstring, 2.)."""
-    from rotortd.segments import spin_contact
     from rotortd.params import RotorParams
+    from rotortd.segments import spin_contact
     from rotortd.segments.spin_contact import HeldInputs, SpinContact
 
     from tests.reference.spin_mp import mp_contact
