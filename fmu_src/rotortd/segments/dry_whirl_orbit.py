@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from itertools import accumulate, repeat
 from operator import mul
 from typing import TYPE_CHECKING, Any
 
@@ -67,6 +68,10 @@ RHO_MIN = 17.0
 E_MATCH = 16.0 * 2.0 ** -52
 """Largest relative difference of a state's energy from the orbit's that continues it (the
 rounding of E recomputed from the end state is a few eps)."""
+TRIM = 1e-17
+"""Kept harmonics at most this relative to the mean (F_00, D_00) are left out of the sums
+and counted with the dropped ones in the error estimate (the DFT's rounding is about 1e-17;
+at most 168 of them add 1.7e-15 of the mean, within TOL_IMPULSE)."""
 EPS_MAX = 0.015
 """Largest c_r |G| + m g e_c relative to E (the potential's modulation of the integrand) for
 which an orbit is built; at 0.015 the chapter's rotor's series meet the tolerance (25 rad/s),
@@ -124,23 +129,26 @@ class Orbit:
         check = [(j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)
                  if abs(j) == k1 or abs(jp) == jp1]
         Wmax = math.sqrt(max((2.0 * self.E + 2.0 * _v_bound(w)) / _i_min(w), 0.0))
-        fast = [c for c in check if c[0]]
-        slow = [c for c in check if not c[0]]
-        self.err_t = _dropped(F, fast, slow, rho1)
-        self.err_d = _dropped(D, fast, slow, rho1)
+        self.f00, self.d00 = F[(0, 0)].real, D[(0, 0)]
+        small_f = _small(F, abs(self.f00))
+        small_d = _small(D, abs(self.d00))
+        self.err_t = _dropped(F, check + small_f, rho1)
+        self.err_d = _dropped(D, check + small_d, rho1)
         self.w_max = Wmax
         self.ok = all(map(math.isfinite, (*self.err_t, *self.err_d)))
-        self.f00, self.d00 = F[(0, 0)].real, D[(0, 0)]
         self.n_sec = F[(1, -1)] * cmath.exp(1j * w.phi)
-        self.A = _rows(lambda j, jp: (F[(j, jp)] / (1j * sig * (j * rho1 + jp))
-                                      if j > 0 or (j == 0 and jp > 0) else 0j), 0)[K_BETA:]
-        # (rows j >= 0 only: t's sum runs over j > 0, and j = 0 < l)
-        self.B = _rows(lambda j, jp: (D[(j, jp)] / (1j * sig * (j * rho1 + jp))
-                                      if (j, jp) != (0, 0) else 0j), 0)
+        skip_f, skip_d = set(small_f), set(small_d)
+        self.A = _trimmed(lambda j, jp: (
+            F[(j, jp)] / (1j * sig * (j * rho1 + jp))
+            if (j > 0 or (j == 0 and jp > 0)) and (j, jp) not in skip_f else 0j), 0)
+        # (t's sum runs over j > 0, and j = 0 < l: the rest is its conjugate)
+        self.B = _trimmed(lambda j, jp: (D[(j, jp)] / (1j * sig * (j * rho1 + jp))
+                                         if (j, jp) != (0, 0) and (j, jp) not in skip_d
+                                         else 0j), 0)
         eph = cmath.exp(1j * w.phi)
-        self.C = _rows(lambda j, jp: (eph * F[(j + 1, jp - 1)] / (1j * sig * (j * rho1 + jp))
-                                      if (j, jp) != (0, 0) and abs(j + 1) <= K_BETA
-                                      and abs(jp - 1) <= K_PSI else 0j), 1)
+        self.C = _trimmed(lambda j, jp: (
+            eph * F[(j + 1, jp - 1)] / (1j * sig * (j * rho1 + jp))
+            if (j, jp) != (0, 0) and abs(j + 1) <= K_BETA and abs(jp - 1) <= K_PSI else 0j), 1)
         vb = _v_bound(w)
         self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
                             + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge))
@@ -204,21 +212,40 @@ class Orbit:
         return fq, dq
 
 
-def _dropped(c: dict[tuple[int, int], complex], fast: list[tuple[int, int]],
-             slow: list[tuple[int, int]], rho1: float) -> tuple[float, float, float]:
-    """The first dropped harmonics of a series c: (sum 2 |c_jl|/|w_jl| and sum |c_jl| over
-    the fast ones, j != 0; sum |c_0l| over the slow ones), so that their integral over du rad
-    of psi is at most min(first, second du) + third du."""
+def _small(c: dict[tuple[int, int], complex], scale: float) -> list[tuple[int, int]]:
+    """The kept harmonics (|j| <= K_BETA, |l| <= K_PSI, not (0, 0)) of a series c at most
+    TRIM scale: left out of the sums (at the rounding level of the grid's DFT, 1e-17 of the
+    mean) and counted with the dropped ones."""
+    return [(j, jp) for j in range(-K_BETA, K_BETA + 1) for jp in range(-K_PSI, K_PSI + 1)
+            if (j, jp) != (0, 0) and abs(c[(j, jp)]) <= TRIM * scale]
+
+
+def _dropped(c: dict[tuple[int, int], complex], left: list[tuple[int, int]], rho1: float
+             ) -> tuple[float, float, float]:
+    """The harmonics of a series c left out of its sum: (sum 2 |c_jl|/|w_jl| and sum |c_jl|
+    over the fast ones, j != 0; sum |c_0l| over the slow ones), so that their integral over
+    du rad of psi is at most min(first, second du) + third du."""
+    fast = [k for k in left if k[0]]
     return (sum(2.0 * abs(c[k]) / abs(k[0] * rho1 + k[1]) for k in fast),
-            sum(abs(c[k]) for k in fast), sum(abs(c[k]) for k in slow))
+            sum(abs(c[k]) for k in fast), sum(abs(c[k]) for k in left if not k[0]))
 
 
-def _rows(coef: Any, wide: int) -> list[list[complex]]:
-    """Rows j = -K_BETA-wide .. K_BETA+wide over l = -K_PSI-wide .. K_PSI+wide of coef(j, l)
-    (the coefficients of the sums ``_series`` evaluates: the kept harmonics, wide = 0; one
-    more each way for int n dt, wide = 1)."""
-    return [[coef(j, jp) for jp in range(-K_PSI - wide, K_PSI + wide + 1)]
-            for j in range(-K_BETA - wide, K_BETA + wide + 1)]
+Row = tuple[int, int, int, list[complex]]
+
+
+def _trimmed(coef: Any, wide: int) -> list[Row]:
+    """The rows j = -K_BETA-wide .. K_BETA+wide over l = -K_PSI-wide .. K_PSI+wide of
+    coef(j, l) (the coefficients of a sum ``_series`` evaluates: the kept harmonics,
+    wide = 0; one more each way for int n dt, wide = 1), each cut to the span of its nonzero
+    entries: (row index into the beta powers, first and end index into the psi powers, the
+    coefficients); rows without any left out."""
+    out = []
+    for a, j in enumerate(range(-K_BETA - wide, K_BETA + wide + 1)):
+        row = [coef(j, jp) for jp in range(-K_PSI - wide, K_PSI + wide + 1)]
+        nz = [i for i, x in enumerate(row) if x]
+        if nz:
+            out.append((a, nz[0], nz[-1] + 1, row[nz[0]:nz[-1] + 1]))
+    return out
 
 
 def _v_bound(w: DryWhirl) -> float:
@@ -244,16 +271,14 @@ def energy(w: DryWhirl) -> float:
 
 def _powers(e: complex, k: int) -> list[complex]:
     """[e^-k, ..., e^k] for |e| = 1."""
-    pos = [1.0 + 0j]
-    for _ in range(k):
-        pos.append(pos[-1] * e)
-    return [x.conjugate() for x in reversed(pos[1:])] + pos
+    pos = list(accumulate(repeat(e, k), mul, initial=1.0 + 0j))
+    return [*map(complex.conjugate, pos[:0:-1]), *pos]
 
 
-def _series(rows: list[list[complex]], eb: list[complex], ep: list[complex]) -> complex:
-    """sum_jl rows[j][l] e^{i j beta} e^{i l psi} from the power lists of e^{i beta} and
-    e^{i psi} (``_powers``)."""
-    return sum(map(mul, eb, [sum(map(mul, r, ep)) for r in rows]))
+def _series(rows: list[Row], eb: list[complex], ep: list[complex]) -> complex:
+    """sum_jl c_jl e^{i j beta} e^{i l psi} over the rows of ``_trimmed`` from the power lists
+    of e^{i beta} and e^{i psi} (``_powers``, of the rows' width)."""
+    return sum([eb[a] * sum(map(mul, c, ep[lo:hi])) for a, lo, hi, c in rows])
 
 
 def advance(prev: Orbit | None, h: HeldInputs, theta: float, psi: float, Omega: float,
@@ -311,13 +336,10 @@ def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: i
     eb0 = _powers(cmath.exp(1j * b_s), K_BETA + 1)
     ep0 = _powers(cmath.exp(1j * psi), K_PSI + 1)
     eb0n, ep0n = eb0[1:-1], ep0[1:-1]  # the kept harmonics' powers
-    s_t0 = _series(orb.A, eb0n[K_BETA:], ep0n)
+    s_t0 = _series(orb.A, eb0n, ep0n)
 
     def t_of(u: float) -> float:
-        eb = [1.0 + 0j]
-        e1 = cmath.exp(1j * (b_s + rho1 * sig * u))
-        for _ in range(K_BETA):
-            eb.append(eb[-1] * e1)
+        eb = _powers(cmath.exp(1j * (b_s + rho1 * sig * u)), K_BETA)
         ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI)
         return orb.f00 * u + 2.0 * (_series(orb.A, eb, ep) - s_t0).real
 
