@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import cmath
 import math
-from itertools import accumulate, repeat
 from operator import mul
 from typing import TYPE_CHECKING, Any
 
@@ -271,7 +270,9 @@ def energy(w: DryWhirl) -> float:
 
 def _powers(e: complex, k: int) -> list[complex]:
     """[e^-k, ..., e^k] for |e| = 1."""
-    pos = list(accumulate(repeat(e, k), mul, initial=1.0 + 0j))
+    pos = [1.0 + 0j]
+    for _ in range(k):
+        pos.append(pos[-1] * e)
     return [*map(complex.conjugate, pos[:0:-1]), *pos]
 
 
