@@ -135,3 +135,32 @@ def test_drivetrain_failure_reaches_stderr(capsys: pytest.CaptureFixture[str]) -
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("drive: error: initialisation failed: ")
     assert "J" in err[0]
+
+
+def test_drivetrain_state_that_cannot_be_captured_fails_on_restore(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """A Drivetrain state whose capture raises is logged and marked invalid; restoring it
+    fails the instance (the next step is refused) instead of restoring part of it."""
+    from Drivetrain import Drivetrain
+
+    slave = Drivetrain(instance_name="drive")
+    slave.setup_experiment(0.0, None, None)
+    slave.enter_initialization_mode()
+    assert slave.exit_initialization_mode() is not False
+    assert slave.do_step(0.0, 1e-3) is not False
+
+    class Broken:
+        def __getattr__(self, name: str) -> Any:
+            raise RuntimeError("no state here")
+
+    good = slave._get_fmu_state()
+    core, slave._core = slave._core, Broken()
+    bad = slave._get_fmu_state()
+    slave._core = core
+    assert bad.get("invalid") == "no state here" and "variables" not in bad
+    slave._set_fmu_state(bad)
+    assert slave.do_step(1e-3, 1e-3) is False
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == "drive: error: getFMUstate failed: no state here", err
+    slave._set_fmu_state(good)
+    assert "invalid" not in good and good["core"] is not None

@@ -122,16 +122,25 @@ class DrivetrainAdapter(GuardedSlave):
 
     # ------------------------------------------------------------------ FMU state
     def _get_fmu_state(self) -> dict[str, Any]:
-        values = {v.name: v.getter() for v in self.vars.values()}
-        core = None if self._core is None else self._core.get_state()
-        return json.loads(json.dumps({"schema": STATE_SCHEMA, "variables": values,
-                                      "core": core, "failure": self._failure,
-                                      "fixed": self._fixed}))
+        """The state as JSON-ready data; a state that cannot be captured is logged and
+        returned marked invalid (as ``touchdown.RotorTouchdownAdapter`` does), so that
+        restoring it fails the instance instead of restoring half a state."""
+        try:
+            values = {v.name: v.getter() for v in self.vars.values()}
+            core = None if self._core is None else self._core.get_state()
+            return json.loads(json.dumps({"schema": STATE_SCHEMA, "variables": values,
+                                          "core": core, "failure": self._failure,
+                                          "fixed": self._fixed}))
+        except Exception as exc:
+            self._error(f"getFMUstate failed: {exc}")
+            return {"schema": STATE_SCHEMA, "invalid": str(exc)}
 
     def _set_fmu_state(self, state: dict[str, Any]) -> None:
         try:
             if state.get("schema") != STATE_SCHEMA:
                 raise ValueError("not a drivetrain FMU state")
+            if "invalid" in state:
+                raise ValueError(f"the saved state is invalid: {state['invalid']}")
             for name, value in state["variables"].items():
                 if name != "Omega":
                     setattr(self, name, value)
