@@ -2,13 +2,18 @@
 something goes wrong.
 
 It takes ``fmpy simulate``'s options for a run (``--start-values NAME VALUE ...``,
-``--start-time``, ``--stop-time``, ``--output-interval``, ``--output-variables``,
-``--output-file``, a CSV as ``fmpy simulate`` writes it) and differs where FMPy is silent:
+``--input-file``, ``--start-time``, ``--stop-time``, ``--output-interval``,
+``--output-variables``, ``--output-file``, a CSV as ``fmpy simulate`` writes it) and differs
+where FMPy is silent:
 
 - before simulating, an unknown variable name (with close matches), a variable that cannot
   be set (an output), a value that does not parse for the variable's type (Real, Integer,
   Boolean: true/false/1/0) or lies outside its declared min/max is refused with a message
-  naming the variable, value, unit and range, exit status 2; so is one of the real bearing's
+  naming the variable, value, unit and range, exit status 2; so is an input file
+  (``--input-file``: a CSV whose first column is ``time`` and whose other columns are inputs
+  of the FMU, as ``fmpy simulate`` reads it) with an unknown or unsettable column, a time
+  column that is not finite and non-decreasing, or a value outside its input's range
+  (every problem at once); so is one of the real bearing's
   twelve parameters (docs/model.md §10) set without ``integrate_spin = true``, or a parameter
   of an option left off (``rotortd_tools.bearing_args``);
 - a progress line on stderr every 5 s of wall time (simulated time, stop time, percent),
@@ -36,6 +41,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from itertools import pairwise
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -65,6 +71,9 @@ def add_simulate_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("fmu", type=Path, help="the FMU file")
     p.add_argument("--start-values", dest="start_values", nargs="+", default=[],
                    metavar="NAME VALUE", help="name-value pairs of parameters and inputs")
+    p.add_argument("--input-file", dest="input_file", type=Path, default=None,
+                   help="CSV of inputs over time: a 'time' column [s], then one column per "
+                   "input (as fmpy simulate reads it)")
     p.add_argument("--start-time", dest="start_time", type=float, default=None,
                    help="start time in s (default: the FMU's default experiment, or 0)")
     p.add_argument("--stop-time", dest="stop_time", type=float, default=None,
@@ -100,6 +109,8 @@ class Run:
     output_interval: float | None
     output: list[str] | None
     output_file: Path | None
+    input: Any = None
+    """The input signals (FMPy's structured array: time, then inputs), or None."""
 
 
 def prepare(args: argparse.Namespace) -> Run:
@@ -129,8 +140,58 @@ def prepare(args: argparse.Namespace) -> Run:
             raise UsageError(f"--output-variables: {_unknown(name, variables)}")
     values = parse_start_values(args.start_values, variables)
     check_bearing(values, variables)
+    signals = (None if getattr(args, "input_file", None) is None
+               else read_inputs(args.input_file, variables))
     return Run(args.fmu, md, values, start, stop, args.output_interval, output,
-               args.output_file)
+               args.output_file, signals)
+
+
+def read_inputs(path: Path, variables: dict[str, Any]) -> Any:
+    """The input file as FMPy reads it, checked: UsageError listing every column that is
+    not an input of the FMU, a time column that is not finite and non-decreasing, and every
+    column with a value outside its input's declared range."""
+    from fmpy.util import read_csv
+
+    if not path.is_file():
+        raise UsageError(f"--input-file {path}: no such file")
+    try:
+        signals = read_csv(str(path))
+    except Exception as exc:
+        raise UsageError(f"--input-file {path}: not a CSV of numbers with a header: "
+                         f"{exc}") from exc
+    names = list(signals.dtype.names or ())
+    if not names or names[0] != "time" or len(names) < 2:
+        raise UsageError(f"--input-file {path}: the first column must be 'time' and at "
+                         f"least one input must follow (columns: {names})")
+    problems: list[str] = []
+    times = [float(t) for t in signals["time"]]
+    if not all(map(math.isfinite, times)) or any(b < a for a, b in pairwise(times)):
+        problems.append("the time column must be finite and non-decreasing")
+    for name in names[1:]:
+        var = variables.get(name)
+        if var is None:
+            problems.append(_unknown(name, variables))
+        elif var.causality != "input":
+            problems.append(f"{name} is {_article(var.causality)} {var.causality}: only "
+                            f"inputs can be given over time (set it with --start-values)")
+        else:
+            bad = _out_of_range(var, [float(x) for x in signals[name]])
+            if bad:
+                problems.append(bad)
+    if problems:
+        raise UsageError(f"--input-file {path}: " + "; ".join(problems))
+    return signals
+
+
+def _out_of_range(var: Any, values: list[float]) -> str:
+    """'' if every value lies in var's declared range, else a message naming the first."""
+    lo, hi = _bound(var, "min"), _bound(var, "max")
+    for i, x in enumerate(values):
+        if not lo <= x <= hi:
+            what = "is not finite" if x != x else "is out of range"
+            return (f"{var.name} = {x!r}{_unit(var, ' ')} in row {i + 1} {what}: it must lie "
+                    f"in [{lo:g}, {hi:g}]{_unit(var, ' ')}")
+    return ""
 
 
 def check_bearing(values: dict[str, Any], variables: dict[str, Any]) -> None:
@@ -368,7 +429,8 @@ def execute(run: Run, every: float) -> int:
         result = simulate_fmu(unzip, model_description=run.md, fmu_instance=fmu,
                               start_time=run.start_time, stop_time=run.stop_time,
                               output_interval=run.output_interval, output=run.output,
-                              start_values=run.start_values, step_finished=step_finished)
+                              start_values=run.start_values, input=run.input,
+                              step_finished=step_finished)
     except FMICallException as exc:
         outcome.status, outcome.function, outcome.time = exc.status, exc.function, progress.t
     except Exception as exc:  # FMPy's own refusals: still a failed run, said plainly
