@@ -6,9 +6,11 @@
    code) over one 1e-4 s step of dry whirl of the chapter's rotor at 60 to 2000 rad/s, as
    ``tests/test_dry_whirl_fast.py`` measures the panels: within 1e-13 of its scales.
 2. Against the extrapolation integrator (``SpinContact`` with ``accelerate`` False) at
-   random rolling states with T_drive = 0 (speeds 60 to 6000 rad/s of both signs, gravity
-   on and off, F_ext up to 2000 N, the bearing off or on with its damper off, J from 0.2 to
-   3 m R^2, steps of 1e-6 to 1e-3 s), each step continuing the previous one's orbit.
+   random rolling states with T_drive = 0 (those of ``tests/test_dry_whirl_fast.py``:
+   speeds 60 to 3000 rad/s of both signs, gravity on and off, F_ext up to 2000 N, the
+   bearing off or on with its damper off, J from 0.2 to 3 m R^2, steps of 1e-6 to 1e-3 s),
+   each step continuing the previous one's orbit; the orbit's grid samples
+   (``DryWhirl.beta_row``) against the one definition of the forces (``DryWhirl._forces``).
 3. The orbit carries over steps and states: the energy stays the same float, a state
    written mid-orbit and restored continues bit for bit, a state written before the orbit
    was recorded (no ``orbit_energy``) loads, and the work of a step does not depend on the
@@ -29,6 +31,7 @@ import pytest
 from rotortd import SpinCore
 from rotortd.params import RotorParams
 from rotortd.segments import dry_whirl_orbit as orbit_mod
+from rotortd.segments.rolling_spin_fast import DryWhirl
 from rotortd.segments.spin_contact import HeldInputs, SpinContact
 
 from tests.test_dry_whirl_fast import (
@@ -43,6 +46,7 @@ from tests.test_dry_whirl_fast import (
     _held,
     _reference,
 )
+from tests.test_dry_whirl_fast import _random_case as _random_fast_case
 
 
 def _advance(h: HeldInputs, th: float, psi: float, W: float, rem: float,
@@ -63,16 +67,9 @@ def test_one_step_matches_the_40_digit_reference(W: float) -> None:
 
 
 def _random_case(rng: random.Random) -> tuple[HeldInputs, float, float, float, float]:
-    W = math.copysign(math.exp(rng.uniform(math.log(60.0), math.log(6000.0))),
-                      rng.choice((1.0, -1.0)))
-    a = rng.choice((0.0, 1.0))
-    p = RotorParams(g=rng.choice((0.0, 9.81)), c=0.0 if a else 1400.0,
-                    levitate=rng.choice((True, False)))
-    F = (complex(rng.uniform(-2e3, 2e3), rng.uniform(-2e3, 2e3)) if rng.random() < 0.5
-         else 0j)
-    h = HeldInputs(p, p.m * p.R ** 2 * rng.uniform(0.2, 3.0), a, F, 0.0)
-    rem = math.exp(rng.uniform(math.log(1e-6), math.log(1e-3)))
-    return h, W, rng.uniform(-4.0, 4.0), rng.uniform(-4.0, 4.0), rem
+    """``test_dry_whirl_fast``'s random rolling state with its drive torque taken off."""
+    h, W, th, psi, rem, _ = _random_fast_case(rng)
+    return HeldInputs(h.p, h.J, h.a, h.F_ext, 0.0), W, th, psi, rem
 
 
 def test_agrees_with_the_integrator_over_steps_on_one_orbit() -> None:
@@ -101,6 +98,29 @@ def test_agrees_with_the_integrator_over_steps_on_one_orbit() -> None:
             th, psi, W = new.theta, new.psi, new.Omega
     assert taken >= 150, taken
     assert all(v <= TOL for v in worst.values()), worst
+
+
+def test_grid_samples_are_the_forces_of_the_one_definition() -> None:
+    """``beta_row`` (the hot loop of the orbit's and the Levin panel's grids) gives F, D and
+    |N| of ``DryWhirl._forces`` at random states, to rounding."""
+    rng = random.Random(3)
+    worst = 0.0
+    for _ in range(200):
+        h, W, th, psi, _, _ = _random_fast_case(rng)
+        w = DryWhirl(h, th, psi, W)
+        betas = [rng.uniform(-math.pi, math.pi) for _ in range(5)]
+        grid = w.beta_grid([math.cos(b) for b in betas], [math.sin(b) for b in betas])
+        a = psi + h.p.phi
+        cE, sE = math.cos(a), math.sin(a)
+        dv = rng.uniform(-1e-3, 1e-3) * w.K0
+        fs, ds, ns = w.beta_row(grid, cE, sE, w.K0 - 2.0 * dv)
+        for b, F, D, N in zip(betas, fs, ds, ns):
+            ct, st = math.cos(a - b), math.sin(a - b)
+            F1, N1, Ft1, _ = w._forces(ct, st, cE, sE, dv)
+            scale = abs(N1) + abs(Ft1)
+            worst = max(worst, abs(F - F1) / F1, abs(D - complex(N1, Ft1) * F1) / (scale * F1),
+                        abs(N - abs(N1)) / scale)
+    assert worst <= 1e-13, worst
 
 
 def _rolling_core(W: float, **kw: float) -> SpinCore:

@@ -173,11 +173,7 @@ class Orbit:
         lo, hi = _omega2_bounds(w, self.E)
         if not (lo > 0.0 and w._no_event(lo, hi)):
             return None
-        m, e_c, c_r, akcr = w.m, w.e_c, w.c_r, w.akcr
-        cen, Gx, Gy, T0, mge = m * c_r * w.rho * w.rho, w.Gx, w.Gy, w.T, w.mge
-        ip = [w.I0 - w.c2 * c for c in _CB]
-        Bs = [e_c * s for s in _SB]
-        As = [w.R - e_c * c for c in _CB]
+        grid = w.beta_grid(_CB, _SB)
         k1 = K_BETA + 1
         rows_f = [_BETA_ROWS[k] for k in range(k1 + 1)]
         rows_d = [_BETA_ROWS[k] for k in range(-k1, k1 + 1)]
@@ -187,22 +183,7 @@ class Orbit:
         for b in range(N_PSI):
             a = 2.0 * math.pi * b / N_PSI + w.phi
             cE, sE = math.cos(a), math.sin(a)
-            base = 2.0 * self.E - 2.0 * mge * sE
-            T = T0 + e_c * (w.F1x * sE - w.F1y * cE)
-            fs, ds, ns = [], [], []
-            for cb, sb, IP, B, A in zip(_CB, _SB, ip, Bs, As):
-                ct, st = cE * cb + sE * sb, sE * cb - cE * sb  # theta = psi + phi - beta
-                g_r, g_i = Gx * ct + Gy * st, Gy * ct - Gx * st  # conj(n) G
-                om2 = (base + 2.0 * c_r * g_r) / IP
-                F = 1.0 / math.sqrt(om2)
-                U = m * e_c * om2
-                rn = g_r - akcr + U * cb + cen * om2
-                Fot = g_i + U * sb
-                dW = (T - akcr * B - B * rn - A * Fot) / IP
-                N = rn + m * B * dW
-                fs.append(F)
-                ns.append(abs(N))
-                ds.append(complex(N * F, (Fot + m * A * dW) * F))
+            fs, ds, ns = w.beta_row(grid, cE, sE, 2.0 * self.E - 2.0 * w.mge * sE)
             self.n_rows.append(max(ns))
             for q, row in zip(fq, rows_f):
                 q.append(sum(map(mul, fs, row)))

@@ -185,6 +185,38 @@ class DryWhirl:
         dW = (T - B * rn - A * Fot) / IP
         return 1.0 / math.sqrt(om2), rn + m * B * dW, Fot + m * A * dW, om2
 
+    def beta_grid(self, cbs: list[float], sbs: list[float]) -> tuple[list[float], ...]:
+        """(cos beta, sin beta, I_P, B = e_c sin beta, A = R - e_c cos beta) on a grid of
+        beta, for ``beta_row``."""
+        e_c = self.e_c
+        return (cbs, sbs, [self.I0 - self.c2 * c for c in cbs], [e_c * s for s in sbs],
+                [self.R - e_c * c for c in cbs])
+
+    def beta_row(self, grid: tuple[list[float], ...], cE: float, sE: float, base: float
+                 ) -> tuple[list[float], list[complex], list[float]]:
+        """F (s/rad), D = (N + i F_t) F (N s/rad) and |N| (N) on the ``beta_grid`` at one
+        psi (E = cE + i sE) where 2 (E - V) = base + 2 c_r Re(conj(n) G): the forces of
+        ``_forces`` written for a grid (the Fourier-Levin panel's and the orbit's samples;
+        tests/test_dry_whirl_orbit.py checks them against ``_forces``)."""
+        m, e_c, c_r, akcr, Gx, Gy = self.m, self.e_c, self.c_r, self.akcr, self.Gx, self.Gy
+        cen = m * c_r * self.rho * self.rho
+        T = self.T + e_c * (self.F1x * sE - self.F1y * cE)
+        fs, ds, ns = [], [], []
+        for cb, sb, IP, B, A in zip(*grid):
+            ct, st = cE * cb + sE * sb, sE * cb - cE * sb  # theta = psi + phi - beta
+            g_r, g_i = Gx * ct + Gy * st, Gy * ct - Gx * st  # conj(n) G
+            om2 = (base + 2.0 * c_r * g_r) / IP
+            F = 1.0 / math.sqrt(om2)
+            U = m * e_c * om2
+            rn = g_r - akcr + U * cb + cen * om2
+            Fot = g_i + U * sb
+            dW = (T - akcr * B - B * rn - A * Fot) / IP
+            N = rn + m * B * dW
+            fs.append(F)
+            ns.append(abs(N))
+            ds.append(complex(N * F, (Fot + m * A * dW) * F))
+        return fs, ds, ns
+
     def _speed(self, u: float) -> float:
         """|Omega| (rad/s) on the path at u, from the energy integral."""
         th = self.theta0 - self.rho * self.sig * u
@@ -430,11 +462,7 @@ class _LevinPanel:
 
     def __init__(self, w: DryWhirl, L: float, p: int) -> None:
         self.L, self.w = L, w
-        m, e_c, c_r, akcr = w.m, w.e_c, w.c_r, w.akcr
-        cen, Gx, Gy, T0 = m * c_r * w.rho * w.rho, w.Gx, w.Gy, w.T
-        ip = [w.I0 - w.c2 * c for c in _CB]  # I_P on the grid
-        Bs = [e_c * s for s in _SB]
-        As = [w.R - e_c * c for c in _CB]
+        grid = w.beta_grid(_CB, _SB)
         rows_f = [_row(k) for k in range(K_MAX + 2)]
         rows_d = [_row(k) for k in range(-K_MAX - 1, K_MAX + 2)]
         qf: list[list[complex]] = [[] for _ in rows_f]
@@ -444,20 +472,7 @@ class _LevinPanel:
         for u in us:
             dv, cE, sE = w._dv_psi(u)
             Es.append(complex(cE, sE))
-            base = w.K0 - 2.0 * dv
-            T = T0 + e_c * (w.F1x * sE - w.F1y * cE)
-            fs, ds = [], []
-            for cb, sb, IP, B, A in zip(_CB, _SB, ip, Bs, As):
-                ct, st = cE * cb + sE * sb, sE * cb - cE * sb  # theta = psi + phi - beta
-                g_r, g_i = Gx * ct + Gy * st, Gy * ct - Gx * st  # conj(n) G
-                om2 = (base + 2.0 * c_r * g_r) / IP
-                F = 1.0 / math.sqrt(om2)
-                U = m * e_c * om2
-                rn = g_r - akcr + U * cb + cen * om2
-                Fot = g_i + U * sb
-                dW = (T - akcr * B - B * rn - A * Fot) / IP
-                fs.append(F)
-                ds.append(complex((rn + m * B * dW) * F, (Fot + m * A * dW) * F))
+            fs, ds, _ = w.beta_row(grid, cE, sE, w.K0 - 2.0 * dv)
             for q, row in zip(qf, rows_f):
                 q.append(sum(map(mul, fs, row)))
             for q, row in zip(qd, rows_d):
