@@ -69,6 +69,21 @@ def _random_case(rng: random.Random) -> tuple[HeldInputs, float, float, float, f
     return h, W, rng.uniform(-4.0, 4.0), rng.uniform(-4.0, 4.0), rem, levin
 
 
+def errors_against_the_integrator(h: HeldInputs, th: float, psi: float, W: float,
+                                  new: SegmentEnd) -> dict[str, float]:
+    """``_errors`` of a segment ``new`` of rolling from (th, psi, W) against the
+    extrapolation integrator (``SpinContact`` with ``accelerate`` False) over its duration;
+    neither may end at an event."""
+    seg = SpinContact(h, 0.0, th, 0.0, psi, W)
+    seg.accelerate = False
+    old = seg.run(new.duration, 10 ** 9)
+    assert old.event is None and new.event is None
+    mc = h.p.m * h.p.c_r
+    tal = old.tally
+    return _errors(new, th, psi, W, old.theta, old.psi, old.Omega, mc * tal.I_n,
+                   mc * tal.I_t, mc * tal.I_c, mc)
+
+
 def test_agrees_with_the_integrator_at_random_states() -> None:
     rng = random.Random(7)
     taken, worst = 0, dict.fromkeys(("theta", "psi", "Omega", "P_n", "P_t", "P_c"), 0.0)
@@ -78,15 +93,8 @@ def test_agrees_with_the_integrator_at_random_states() -> None:
         if new is None:
             continue
         taken += 1
-        seg = SpinContact(h, 0.0, th, 0.0, psi, W)
-        seg.accelerate = False
-        old = seg.run(new.duration, 10 ** 9)
-        assert old.event is None and new.event is None
         assert new.duration == rem or new.duration < rem  # the panel may end first
-        mc = h.p.m * h.p.c_r
-        tal = old.tally
-        err = _errors(new, th, psi, W, old.theta, old.psi, old.Omega, mc * tal.I_n,
-                      mc * tal.I_t, mc * tal.I_c, mc)
+        err = errors_against_the_integrator(h, th, psi, W, new)
         for k, v in err.items():
             worst[k] = max(worst[k], v)
     assert taken >= 70, taken
