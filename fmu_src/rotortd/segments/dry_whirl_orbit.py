@@ -325,7 +325,8 @@ def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: i
         ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI)
         return orb.f00 * u + 2.0 * (_series(orb.A, eb, ep) - s_t0).real
 
-    u = rem / orb.f00 if rem * abs(w.Omega0) * rho1 > 2.0 * math.pi else rem * abs(w.Omega0)
+    u = rem * abs(w.Omega0)  # where beta turns at least once: the mean rate; else the
+    u = rem / orb.f00 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u)  # midpoint
     for _ in range(NEWTON_ITERS):  # t' = F = 1/|Omega|; the error after an update of du is
         du = (t_of(u) - rem) * w._speed(u)  # at most kappa/2 du^2 (kappa >= |F'/F|)
         u = max(0.0, u - du)
