@@ -104,7 +104,7 @@ class Orbit:
     on first use (``build``; an orbit restored from a state is built at its next step)."""
 
     __slots__ = ("A", "B", "C", "E", "built", "d00", "err_d", "err_t", "f00", "kappa",
-                 "key", "n_rows", "n_sec", "ok", "sig", "w_max")
+                 "key", "n_rows", "n_sec", "ok", "w_max")
 
     def __init__(self, E: float, key: Key) -> None:
         self.E, self.key = E, key
@@ -112,7 +112,7 @@ class Orbit:
 
     def build(self, w: DryWhirl) -> None:
         """The coefficients from the grid, with ``w``'s constants (the held inputs of key)."""
-        self.built, self.sig = True, w.sig
+        self.built = True
         grid = self._grid(w)
         if grid is None:
             return
@@ -127,13 +127,12 @@ class Orbit:
         rho1, sig = 1.0 + w.rho, w.sig
         check = [(j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)
                  if abs(j) == k1 or abs(jp) == jp1]
-        Wmax = math.sqrt(max((2.0 * self.E + 2.0 * _v_bound(w)) / _i_min(w), 0.0))
         self.f00, self.d00 = F[(0, 0)].real, D[(0, 0)]
         small_f = _small(F, abs(self.f00))
         small_d = _small(D, abs(self.d00))
         self.err_t = _dropped(F, check + small_f, rho1)
         self.err_d = _dropped(D, check + small_d, rho1)
-        self.w_max = Wmax
+        self.w_max = math.sqrt(max(_omega2_bounds(w, self.E)[1], 0.0))  # |Omega| on it
         self.ok = all(map(math.isfinite, (*self.err_t, *self.err_d)))
         self.n_sec = F[(1, -1)] * cmath.exp(1j * w.phi)
         skip_f, skip_d = set(small_f), set(small_d)
@@ -148,10 +147,9 @@ class Orbit:
         self.C = _trimmed(lambda j, jp: (
             eph * F[(j + 1, jp - 1)] / (1j * sig * (j * rho1 + jp))
             if (j, jp) != (0, 0) and abs(j + 1) <= K_BETA and abs(jp - 1) <= K_PSI else 0j), 1)
-        vb = _v_bound(w)
         self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
                             + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge))
-                            / (2.0 * self.E - 2.0 * vb))
+                            / (2.0 * self.E - 2.0 * _v_bound(w)))
 
     def peak_on(self, psi_a: float, psi_b: float) -> float:
         """The largest |N| (N) on the beta grid of the rows psi_b of the grid that lie
