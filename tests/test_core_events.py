@@ -337,3 +337,33 @@ def test_bracket_left_is_the_one_root_finder_inlined() -> None:
                              lambda a, b, _: b - a <= BRACKET_RTOL * b, 100)
         assert left == ref, (g0, g1, g2, g3, hi)
     assert checked > 1000
+
+
+def test_illinois_takes_the_secant_of_f_minus_the_level() -> None:
+    """The root finder locates the crossing of a positive level as fast as that of zero:
+    on random smooth decreasing functions whose ends are both positive (the held sliding's
+    event functions cross their rounding band, level 64 eps), the secant of f - level
+    converges superlinearly: 6 to 14 evaluations to a bracket of 2e-16 relative. The secant
+    of f itself left the bracket and bisected: 15 to 100 (the limit) on the same functions."""
+    from rotortd.segments.roots import illinois
+
+    rng = random.Random(26)
+    level = 64.0 * 2.220446049250313e-16
+    for _ in range(200):
+        a0, a1, a2 = rng.uniform(0.5, 2.0), rng.uniform(0.1, 1.0), rng.uniform(-0.3, 0.3)
+        x0 = rng.uniform(0.1, 0.9)
+
+        def f(x: float, a0: float = a0, a1: float = a1, a2: float = a2,
+              x0: float = x0) -> float:
+            d = x0 - x
+            return level + d * (a0 + d * (a1 + d * a2))
+
+        calls = []
+
+        def at(x: float) -> tuple[float, None]:
+            calls.append(x)
+            return f(x), None
+
+        _, b, _ = illinois(at, 0.0, f(0.0), 1.0, f(1.0), None,
+                           lambda a, b, g: b - a <= 2e-16 * b or g == 0.0, 100, level)
+        assert abs(b - x0) <= 1e-14 and len(calls) <= 16, (x0, len(calls))

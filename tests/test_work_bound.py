@@ -131,7 +131,7 @@ def test_spin_core_leaves_the_wall_inward() -> None:
 def test_force_of_1e12_newton_stays_within_the_bound() -> None:
     """F_x = 1e12 N presses the rotor into the bearing (default parameters, 1e-4 s steps):
     a stiff, lightly damped friction pendulum at sqrt(F/(m c_r)) = 5.3e6 rad/s that the
-    sliding integrator follows at about 0.5 rad per step, some 45,000 units per step.
+    sliding integrator follows at about 0.5 rad per step, some 107,000 units per step.
     Every step ends OK, well within the bound (the full 200 steps: the slow group)."""
     core = TouchdownCore(BASE)
     for _ in range(10):
@@ -191,3 +191,14 @@ def test_a_stop_below_the_bound_does_not_claim_it() -> None:
         assert rep.status == STATUS_WORK_CAP
         assert rep.message.startswith("work bound reached") == claim, rep.message
         assert f"{used}" in rep.message and "no a-priori bound" in rep.message, rep.message
+
+
+def test_the_overshoot_covers_one_sliding_event_location() -> None:
+    """WORK_OVERSHOOT is at least the largest piece between two checks of the bound: a
+    step of the held sliding integrator and its event location (segments.sliding), each
+    extrapolation at most 9 columns of right-hand sides and its step work."""
+    from rotortd.segments import gbs
+    from rotortd.segments.roots import ROOT_ITERS
+
+    extrapolation = gbs.RHS_WORK * sum(gbs.SEQUENCE) + gbs.STEP_WORK
+    assert WORK_OVERSHOOT >= (1 + 41 + ROOT_ITERS) * extrapolation

@@ -64,10 +64,12 @@ WORK_MAX = 1_600_000
 step that would need more stops with STATUS_WORK_CAP (TouchdownCore and SpinCore alike).
 Every loop of the core counts into one counter; it is checked before each segment, at
 each advance of the contact search and at each step of the sliding integrator."""
-WORK_OVERSHOOT = 14_100
+WORK_OVERSHOOT = 20_000
 """Most work units a step can use beyond WORK_MAX: what runs between two checks of the
-bound. The largest such piece is one event location of the sliding integrator (at most
-142 re-integrations of at most 98 units each, contact.Sliding._locate) with its step."""
+bound. The largest such piece is a step of the held sliding integrator with its event
+location: at most 1 + 41 + ROOT_ITERS = 102 extrapolations (the step, stepping off the
+event surface, the root finder) of at most gbs.RHS_WORK * 90 + gbs.STEP_WORK = 196 units
+each, 19,992 (segments.sliding.Sliding._locate; tests/test_work_bound.py)."""
 SEGMENT_WORK = 8
 """Work units charged for each segment of a step's event loop (a flight to the next event,
 an impact, a contact segment, a mode change): its fixed cost besides the loops it runs

@@ -63,16 +63,14 @@ from ..contact.events import (
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactWorkExceeded
 from . import gbs
-from .roots import illinois
-from .spin_contact import H_FRACTION, ROOT_ITERS, RTOL, HeldInputs
-from .spin_contact import RHS_WORK as SPIN_RHS_WORK
-from .spin_contact import STEP_WORK as SPIN_STEP_WORK
+from .roots import ROOT_ITERS, illinois
+from .spin_contact import H_FRACTION, RTOL, HeldInputs
 
 Vector = list[float]
-RHS_WORK = 2 * SPIN_RHS_WORK
+RHS_WORK = 2 * gbs.RHS_WORK
 """Work units per right-hand side: twice the spin-state contact's (measured 5.7 us against
 3.1 us a call, and 21 components against 9 in the extrapolation's sweeps)."""
-STEP_WORK = 2 * SPIN_STEP_WORK
+STEP_WORK = 2 * gbs.STEP_WORK
 """Work units per extrapolated step beyond its right-hand sides (as RHS_WORK)."""
 _R_SLIDE, _R_STICK, _CLAMPED, _C_SLIDE, _C_STICK = range(5)
 """The contact's kinds in BearingModel (the rigid law's below _CLAMPED)."""

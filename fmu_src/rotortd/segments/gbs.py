@@ -17,6 +17,15 @@ Sweep = Callable[[float, Sequence[float], Sequence[float], float, int], Vector]
 """A modified-midpoint sweep (u0, y0, f0, H, n) -> y(u0 + H): ``midpoint`` with its right-hand
 side bound, or a caller's fused copy of it (contact.Sliding.midpoint_sweep)."""
 
+RHS_WORK = 2
+"""Work units per right-hand side of an extrapolated contact integrator (the held sliding,
+the contact segments with the spin a state): one costs 2.2 us here, about twice a search
+advance's unit (measured: the held sliding at 2.2 us per right-hand side, the spin state's
+rolling at 1.1 us per unit; docs/model.md 7)."""
+STEP_WORK = 16
+"""Work units per extrapolated step beyond its right-hand sides: the tableau, error norm,
+event test and step control (about 100 us at 9 columns, less at fewer)."""
+
 SEQUENCE = (2, 4, 6, 8, 10, 12, 14, 16, 18)
 """Substep counts of the modified midpoint rule (the 'double harmonic' sequence)."""
 

@@ -91,7 +91,7 @@ MARGIN = 1e-9
 NEWTON_ITERS = 12
 """Most Newton iterations of the step end (it converges in 3 to 5)."""
 SAMPLE_WORK = 2
-"""Work units per sample of the integrand (as spin_contact.RHS_WORK per right-hand side)."""
+"""Work units per sample of the integrand (as gbs.RHS_WORK per right-hand side)."""
 
 
 def _cheb_tables(p: int) -> tuple[list[float], list[list[float]], list[list[float]]]:

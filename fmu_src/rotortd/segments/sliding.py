@@ -17,7 +17,7 @@ from ..contact.events import LIFT_OFF, SLIP_STUCK, SLIP_ZERO, Event
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd, WallForces
 from . import gbs
-from .roots import illinois
+from .roots import ROOT_ITERS, illinois
 
 RTOL = 1e-13
 """Relative tolerance of the sliding integrator."""
@@ -33,13 +33,6 @@ SCALE_FLOOR = 2.2250738585072014e-308
 forces (a 1e-313 N load, no spin, no stiffness) the scale RTOL * force * step underflowed
 to 0 and the error ratio divided by it (fuzzing). Far below any resolvable integral, it
 changes no scale that does not underflow."""
-GBS_STEP_WORK = 8
-"""Work units charged per extrapolated step of the sliding integrator on top of its
-right-hand-side evaluations: the extrapolation tableau, error norm, event test and step
-control cost about as much as 8 evaluations (measured; docs/model.md 7)."""
-
-
-
 class Sliding:
     """One sliding segment with slip sign ``slip`` from (theta0, dtheta0, E0)."""
 
@@ -224,7 +217,7 @@ class Sliding:
                 self.midpoint_sweep, u, y, f0, step, scale, k_min=2 if cut else K_MIN,
                 aux_scale=self._aux_scale(step, y), aux_evals=self.aux_evals,
             )
-            tally.work += nfev + GBS_STEP_WORK + (self.aux_evals[0] - aux0)
+            tally.work += gbs.RHS_WORK * (nfev + self.aux_evals[0] - aux0) + gbs.STEP_WORK
             if not err <= 1.0:  # also rejects NaN (an overflowing trial step)
                 H = gbs.next_step_size(step, err, k) if err == err else 0.1 * step
                 continue
@@ -292,15 +285,18 @@ class Sliding:
         s_n = wf.gn_tol(y[1]) / (64.0 * 2.220446049250313e-16)  # force scale, 1/s^2
         s_v = abs(wf.wr) + abs(y[1]) + wf.omega_ref(y[1])  # rate scale, 1/s
 
+        seen: dict[float, float] = {}  # the normalised event function at each point
+
         def at(x: float) -> tuple[list[float], float]:
             aux0 = self.aux_evals[0]
             yx, _, _, nfev = gbs.extrapolated_step(
                 self.midpoint_sweep, u, y, f0, x, self.scale, k_fixed=max(k, 4),
                 aux_scale=self._aux_scale(x, y), aux_evals=self.aux_evals,
             )
-            tally.work += nfev + GBS_STEP_WORK + (self.aux_evals[0] - aux0)
+            tally.work += gbs.RHS_WORK * (nfev + self.aux_evals[0] - aux0) + gbs.STEP_WORK
             gn, sv = self.events(yx, u + x)
-            return yx, min(gn / s_n, sv / s_v)
+            seen[x] = f = min(gn / s_n, sv / s_v)
+            return yx, f
 
         noise = 64.0 * 2.220446049250313e-16  # rounding band of the normalised events
         y_hi, fhi = at(H)
@@ -319,9 +315,12 @@ class Sliding:
                 kind = self._kind(y_x, u + H * 2.0**-40, s_n, s_v)
                 stuck = kind is SLIP_ZERO and abs(sv0) <= noise * s_v
                 return H * 2.0**-40, y_x, SLIP_STUCK if stuck else kind
+        # Stop on the event surface: at a point within the rounding band of the event
+        # functions, or where the bracket is one or two ulp of the time.
         _, hi, y_best = illinois(
             lambda x: at(x)[::-1], lo, flo, H, fhi, y_hi,
-            lambda lo, hi, _: hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300, 100, noise)
+            lambda lo, hi, _: seen[hi] >= -noise or hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300,
+            ROOT_ITERS, noise)
         return hi, y_best, self._kind(y_best, u + hi, s_n, s_v)
 
     def _kind(self, y: list[float], u: float, s_n: float, s_v: float) -> Event:

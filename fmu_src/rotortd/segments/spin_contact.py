@@ -40,23 +40,13 @@ from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
 from . import dry_whirl_orbit, gbs, rolling_spin_fast
-from .roots import illinois
+from .gbs import RHS_WORK, STEP_WORK
+from .roots import ROOT_ITERS, illinois
 
 RTOL = 1e-13
 """Relative tolerance per extrapolated step, every component."""
 H_FRACTION = 1.0
 """Largest step, in radians of the fastest rotation of the contact (theta', Omega, beta')."""
-RHS_WORK = 2
-"""Work units per right-hand side: one costs about twice the held core's sliding one
-(measured 2.2 us per unit in rolling at one unit each; docs/model.md 7)."""
-STEP_WORK = 16
-"""Work units per extrapolated step beyond its right-hand sides (twice
-sliding.GBS_STEP_WORK, as RHS_WORK)."""
-ROOT_ITERS = 60
-"""Most regula-falsi iterations of an event location (Illinois; bisection where it stalls
-reaches 4 ulp in at most 53). With at most 9 columns, 18 + ... + 2 = 90 right-hand sides,
-an event location costs at most 60 (2 * 90 + 16) = 11,760 units, inside events.WORK_OVERSHOOT."""
-
 Vector = list[float]
 
 
