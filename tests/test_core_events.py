@@ -358,9 +358,9 @@ def test_illinois_takes_the_secant_of_f_minus_the_level() -> None:
             d = x0 - x
             return level + d * (a0 + d * (a1 + d * a2))
 
-        calls = []
+        calls: list[float] = []
 
-        def at(x: float) -> tuple[float, None]:
+        def at(x: float, f=f, calls: list[float] = calls) -> tuple[float, None]:
             calls.append(x)
             return f(x), None
 
