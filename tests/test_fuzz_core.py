@@ -13,7 +13,6 @@ from __future__ import annotations
 import cmath
 import math
 import os
-from collections.abc import Iterator
 
 import pytest
 from hypothesis import HealthCheck, Phase, assume, given, seed, settings
@@ -22,34 +21,6 @@ from rotortd import WORK_MAX, RotorParams, ScaledParams, TouchdownCore, work_cap
 
 pytestmark = pytest.mark.slow
 MAX_RADIANS = 40.0
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _stream_from_the_seed_alone() -> Iterator[None]:
-    """The example stream as the seed alone makes it. Hypothesis (6.131 and later) mixes
-    literal constants harvested from every local module imported so far into its draws, so
-    any edit of the core (a new constant in a module the test never reaches) changed which
-    scenes this fixed-seed test explores: session 14 found two failing scenes that way (a
-    negative dissipation at the rounding band of N, now bounded in the assertion; and a
-    grazing lift-off that ends flight after flight at ~1e-15 s until the work bound, open,
-    docs/benchmarks.md). Without the harvest every run and every tree replays one stream."""
-    try:
-        from hypothesis.internal.conjecture import providers
-    except ImportError:  # pragma: no cover (an older Hypothesis: nothing to switch off)
-        yield
-        return
-    harvest = getattr(providers, "_get_local_constants", None)
-    if harvest is None:  # pragma: no cover
-        yield
-        return
-    empty = providers._local_constants.__class__(
-        integers=providers.SortedSet(), floats=providers.SortedSet(key=providers.float_to_int),
-        bytes=providers.SortedSet(), strings=providers.SortedSet())
-    providers._get_local_constants = lambda: empty
-    try:
-        yield
-    finally:
-        providers._get_local_constants = harvest
 
 
 def _logu(lo: float, hi: float) -> st.SearchStrategy[float]:
