@@ -41,6 +41,7 @@ from ..segments.flight import FlightModel, Modes
 from .events import CLEAR, IMPACT, TOUCH, Event
 
 EPS = 2.220446049250313e-16
+INF = math.inf
 TOL_G_ULPS = 64.0
 """Contact resolution: g >= -TOL_G_ULPS * eps * c_r^2 counts as at the wall."""
 TINY = 5e-324
@@ -59,6 +60,18 @@ slack G4 tau/4 grows with the interval, so a longer one only shortens the safe s
 MAX_ADVANCES = 400
 """Advances in one search call (a grazing pass needs ~40); a flight creeping along the
 wall for long may need more, and the caller then resumes from where the search stopped."""
+CREEP = 2.0**-20
+"""An advance shorter than CREEP times its interval is creeping: the Taylor bound of g'''
+(g3 plus the quartic slack) is loose there, by up to 1e9 where the orbit osculates the
+circle after a lift-off at N = 0 (flights of 7.5e-16 s until the work bound, found by the
+core fuzz), and the modes' bound is tried (ContactLocator._creep_step)."""
+CREEP_RUN = 16
+"""Creeping advances of one search, the gap not closing (g' <= 0), before the modes' bound is
+tried: a flight that creeps along the wall does so for thousands; the short flights between
+the impacts of a chattering sequence take a few creeping advances each, and keep the Taylor
+bound (the same bits as before the modes' bound existed)."""
+CREEP_WORK = 4
+"""Work units of the modes' bound of g''' (16 pairs of modes, about four points' work)."""
 WORK_MAX = 1_600_000
 """Work bound of one communication step, in work units (``Work``; docs/model.md 7): a
 step that would need more stops with STATUS_WORK_CAP (TouchdownCore and SpinCore alike).
@@ -309,6 +322,17 @@ class ContactLocator:
         z, v = self.fm.propagate(self.z0, self.v0, self.E0, s)
         return z, v, self.E0 * cmath.exp(1j * self.fm.Omega * s)
 
+    def _creep_bound(self, s: float, work: Work) -> float:
+        """The modes' bound of |g'''| from local time s on (Modes.g3_bound: the amplitudes
+        only decay, so it holds for the rest of the search), for a search that creeps (an
+        advance shorter than CREEP times its interval); NaN when the modes are ill
+        conditioned (no bound, and no second try: NaN compares false)."""
+        md = self._get_modes()
+        if md is None:
+            return math.nan
+        work.evals += CREEP_WORK
+        return md.g3_bound(s)
+
     def _get_modes(self) -> Modes | None:
         """The flight's modes (FlightModel.modes), built on first use; None when they are
         ill conditioned (then points come from the divided-difference flight map)."""
@@ -360,7 +384,9 @@ class ContactLocator:
         exact g''' plus g3_slack, and steps to the bound's first root, or by tau if it
         has none there. (The plain cubic bound needed a second, shorter tau near a root;
         with the slack G4 tau/4 already small beside g''' there, re-bounding cost more than
-        it saved.)
+        it saved.) A search that creeps (CREEP_RUN advances shorter than CREEP of their
+        interval, the gap not closing) bounds g''' by the modes from there on, where that is
+        smaller (``_creep_bound``; docs/model.md §3, creeping flights).
 
         The loop is the core's hottest code (about 8 trial points per flight, 11% fewer
         instructions inline), so it evaluates the point, its bound and safe_step's quick
@@ -381,6 +407,7 @@ class ContactLocator:
         neg_rescale = -_NO_RESCALE
         exp = cmath.exp
         modal = 0  # 1: points by Modes.at (inline), -1: by self.state, 0: not decided yet
+        c3_modes, creep, creeps = INF, CREEP, 0  # the modes' bound of |g'''| once creeping
         for _ in range(MAX_ADVANCES if limit >= MAX_ADVANCES else max(limit, 1)):
             acc = -beta * v - kappa * z + f0 + F1 * E
             zc = z.conjugate()
@@ -412,6 +439,8 @@ class ContactLocator:
                 V = abs(v) + K * tau
                 slack = 0.25 * tau * (q0 + V * (q1 + V * q2))
             c3 = g3 + (slack + 16.0 * EPS * (s0 + V * (s1 + V * s2)) + TINY)
+            if c3 > c3_modes:  # (creeping: the modes' bound is the tighter one)
+                c3 = c3_modes
             if g <= neg_rescale:  # safe_step's quick test (no rescaling can apply)
                 p3 = tau * c3 / 6.0 if c3 > 0.0 else 0.0
                 p2 = 0.5 * g2 if g2 > 0.0 else 0.0
@@ -425,6 +454,13 @@ class ContactLocator:
             else:
                 u = (safe_step(g, g1, g2, c3, tau, work) if quiet is None
                      else _first_root_step(g, g1, g2, c3, tau, work))
+                if u is not None and u < creep * tau and g1 <= 0.0:
+                    creeps += 1
+                    if creeps == CREEP_RUN:
+                        c3_modes = self._creep_bound(s, work)
+                        if c3 > c3_modes:
+                            um = safe_step(g, g1, g2, c3_modes, tau, work)
+                            u = um if um is None or um > u else u
                 if u is None:
                     if tau >= remaining:
                         return None

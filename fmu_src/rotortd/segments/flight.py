@@ -372,6 +372,29 @@ class Modes:
         zs = self.Z1 * rot
         return self.Z0 + zs + e1 + e2, self.iw * zs + self.l1 * e1 + self.l2 * e2, rot
 
+    def g3_bound(self, s: float) -> float:
+        """A bound (m^2/s^3) of |g'''| on [s, inf) for g = |z|^2 - c_r^2 along this flight.
+
+        g is the sum over ordered pairs of modes of A_j conj(A_k) e^{(mu_j + conj mu_k) t},
+        so |g'''| <= sum |A_j(s)| |A_k(s)| |mu_j + conj mu_k|^3 while no mode grows, plus 16
+        eps of the largest such term for the amplitudes' rounding. Where the orbit osculates
+        the circle, the terms that would be large vanish exactly (a circular whirl's own
+        pair has mu + conj mu = 0), and this is smaller than the search's Taylor bound by up
+        to 1e9 (contact.search.CREEP). inf when a mode grows (Re mu > 0)."""
+        l1, l2 = self.l1, self.l2
+        if l1.real > 0.0 or l2.real > 0.0:
+            return math.inf
+        amps = (abs(self.Z0), abs(self.Z1), abs(self.a1) * math.exp(l1.real * s),
+                abs(self.a2) * math.exp(l2.real * s))
+        rates = (0j, self.iw, l1, l2)
+        total = top = 0.0
+        for a, mu in zip(amps, rates):
+            for b, nu in zip(amps, rates):
+                r = abs(mu + nu.conjugate())
+                total += a * b * (r * r * r)
+                top = max(top, (a + b) * (a + b) * (r * r * r))
+        return total + 16.0 * 2.220446049250313e-16 * top
+
 
 def _eigenvalues(beta: float, kappa: float) -> tuple[complex, complex]:
     """Eigenvalues (1/s) of [[0, 1], [-kappa, -beta]], the more negative one first.
