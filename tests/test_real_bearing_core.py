@@ -197,8 +197,8 @@ def test_a_dip_of_an_event_function_inside_one_step_is_found() -> None:
     psi_c, eps = y0[4] + W * (u + 0.5 * H), 0.1 * W * H
 
     class Dip(BearingModel):
-        def events(self, y: list[float], n_slack: float = 0.0) -> list[tuple[Any, float]]:
-            return [*super().events(y, n_slack), (LIFT_OFF, (y[4] - psi_c) ** 2 - eps**2)]
+        def events(self, y: list[float]) -> list[tuple[Any, float]]:
+            return [*super().events(y), (LIFT_OFF, (y[4] - psi_c) ** 2 - eps**2)]
 
     dip = BearingContact(held, core._law, core._cstate, y0)
     dip.model = Dip(held, core._law, core._cstate)

@@ -277,7 +277,7 @@ class BearingModel:
         return [*e[14:], N, Ft, Ft * ny - N * nx, -N * ny - Ft * nx, Ft * vrel, damp,
                 -T_b * y[10], E_sup, Fsx, Fsy]
 
-    def events(self, y: Vector, n_slack: float = 0.0) -> list[tuple[Event, float]]:
+    def events(self, y: Vector) -> list[tuple[Event, float]]:
         """The event functions at y (module docstring), each positive while the segment
         lasts."""
         f = self.forces(y)
@@ -287,9 +287,9 @@ class BearingModel:
             out.append((SEPARATE, f.delta))
             if cs.clamped:
                 return [*out, (CLAMP_END, -f.N_law), *self._race_events(y, f)]
-            out.append((LIFT_OFF, f.N_law + n_slack))
+            out.append((LIFT_OFF, f.N_law))
         else:
-            out.append((LIFT_OFF, f.N + n_slack))
+            out.append((LIFT_OFF, f.N))
         if self.mu == 0.0:  # no friction: the slip has no events
             pass
         elif cs.s != 0.0:
@@ -359,9 +359,8 @@ class BearingContact:
     """One contact segment with the real bearing from the state y0 (NY floats)."""
 
     def __init__(self, h: HeldInputs, law: BearingLaw, cs: ContactState, y0: Vector,
-                 step0: float = math.inf, n_slack: float = 0.0) -> None:
+                 step0: float = math.inf) -> None:
         self.model = BearingModel(h, law, cs)
-        self.n_slack = n_slack
         self.y0 = list(y0)
         p = h.p
         f = self.model.forces(self.y0)
@@ -391,7 +390,7 @@ class BearingContact:
 
     def _margin(self, y: Vector) -> float:
         """The least event function (its first zero is the first event)."""
-        return min(v for _, v in self.model.events(y, self.n_slack))
+        return min(v for _, v in self.model.events(y))
 
     def _sweep(self) -> Callable[[float, Vector, Vector, float, int], Vector]:
         rhs = self.model.rhs
@@ -429,7 +428,7 @@ class BearingContact:
                 top, w3 = self._peak_in_step(sweep, u, y, f0, y_ev, tau, k, scale)
                 work += w2 + w3
                 u, y = u + tau, y_ev
-                event = min(model.events(y, self.n_slack), key=lambda e: e[1])[0]
+                event = min(model.events(y), key=lambda e: e[1])[0]
                 N_peak = max(N_peak, top)
                 break
             top, w2 = self._peak_in_step(sweep, u, y, f0, y1, Hs, k, scale)
@@ -505,7 +504,7 @@ class BearingContact:
         then again before its zero while another is not positive there."""
         work = 0
         rigid = not self.model.law.compliant
-        model, slack = self.model, self.n_slack
+        model = self.model
 
         def state(tau: float) -> Vector:
             nonlocal work
@@ -515,9 +514,9 @@ class BearingContact:
                 model.project(yt)
             return yt
 
-        start = [v for _, v in model.events(y, slack)]
+        start = [v for _, v in model.events(y)]
         yb = state(b)
-        ends = [v for _, v in model.events(yb, slack)]
+        ends = [v for _, v in model.events(yb)]
         neg = [i for i, v in enumerate(ends) if v <= 0.0]
         if not neg:
             return None
@@ -526,12 +525,12 @@ class BearingContact:
 
             def at(x: float, i: int = i) -> tuple[float, Vector]:
                 yt = state(x)
-                return model.events(yt, slack)[i][1], yt
+                return model.events(yt)[i][1], yt
 
             _, b, yb = illinois(at, 0.0, start[i], b, ends[i], yb,
                                 lambda a, b, fb: b - a <= 4.0 * math.ulp(u + b) or fb == 0.0,
                                 ROOT_ITERS)
-            ends = [v for _, v in model.events(yb, slack)]
+            ends = [v for _, v in model.events(yb)]
             neg = [j for j, v in enumerate(ends) if v <= 0.0 and j != i]
             if not neg:
                 break

@@ -131,14 +131,11 @@ class BearingSteps:
         if end.event is None:
             return h
         s_wall = st.later(s, min(end.duration, rem))
-        sticky = s_wall == s == st.sticky_at
         st.work.iters += EVENT_WORK
-        if not self._bearing_at_circle(t0 + s_wall + st.s_lo, held, rep, st, sticky):
-            st.sticky_at = s_wall
+        self._bearing_at_circle(t0 + s_wall + st.s_lo, held, rep)
         return s_wall
 
-    def _bearing_at_circle(self, t: float, held: HeldInputs, rep: StepReport,
-                           st: StepContext, sticky: bool) -> bool:
+    def _bearing_at_circle(self, t: float, held: HeldInputs, rep: StepReport) -> bool:
         """The flight reached the race's circle at t (s). Compliant law: the contact closes
         if the rotor moves (or, touching, accelerates) into the race. Rigid law: an impact
         if it moves outward, then contact by the low-speed rule. False when it touched and
@@ -154,12 +151,12 @@ class BearingSteps:
             if rdot <= 0.0 and model.free_normal_acceleration(self._bearing_state()) <= 0.0:
                 return False
             chi = self._c_d / max(rdot, V_FLOOR)
-            return self._bearing_enter(held, st, chi, 0.0)
+            return self._bearing_enter(held, chi)
         if rdot > 0.0:
             if self._bearing_impact(t, n, rdot, held, rep):
-                self._bearing_enter(held, st, 0.0, 0.0)
+                self._bearing_enter(held, 0.0)
             return True
-        return self._bearing_enter(held, st, 0.0, st.n_slack if sticky else 0.0)
+        return self._bearing_enter(held, 0.0)
 
     def _bearing_impact(self, t: float, n: complex, rdot: float, held: HeldInputs,
                         rep: StepReport) -> bool:
@@ -202,16 +199,14 @@ class BearingSteps:
 
     # ------------------------------------------------------------------ contact
 
-    def _bearing_enter(self, held: HeldInputs, st: StepContext, chi: float,
-                       n_min: float) -> bool:
+    def _bearing_enter(self, held: HeldInputs, chi: float) -> bool:
         """Enter sustained contact from the state at the circle: the classifier's state, or
         flight (False) when there is no contact force."""
-        cs = self._bearing_classify(held, chi, n_min)
+        cs = self._bearing_classify(held, chi)
         if cs is None:
             self._on_wall = True
             return False
         self._bearing_set_contact(cs)
-        st.n_slack = -n_min
         return True
 
     def _bearing_set_contact(self, cs: ContactState) -> None:
@@ -219,8 +214,8 @@ class BearingSteps:
         self._mode = MODE_ROLLING if cs.s == 0.0 else MODE_SLIDING
         self._slip = cs.s
 
-    def _bearing_classify(self, held: HeldInputs, chi: float, n_min: float = 0.0,
-                          clamped: bool = False) -> ContactState | None:
+    def _bearing_classify(self, held: HeldInputs, chi: float, clamped: bool = False
+                          ) -> ContactState | None:
         """The contact's discrete state at the current state (None: no contact force, the
         rotor is in flight). The race at rest is held while the static torque it needs is
         within T_b0; at zero slip the contact sticks while |F_t| <= mu N, else slides in the
@@ -257,7 +252,7 @@ class BearingSteps:
             if not clamped and f.N_law <= 0.0 and f.delta > 0.0:
                 return ContactState(s, True, chi, cs.race_held, cs.s_b)
             return cs
-        return cs if n_min < f.N else None
+        return cs if f.N > 0.0 else None
 
     def _bearing_advance_contact(self, s: float, h: float, rep: StepReport, st: StepContext
                                  ) -> float:
@@ -265,7 +260,7 @@ class BearingSteps:
         at its end."""
         rem = (h - s) - st.s_lo
         seg = BearingContact(st.held, self._law, self._cstate, self._bearing_state(),
-                             self._slide_step, st.n_slack if s == st.sticky_at else 0.0)
+                             self._slide_step)
         end = seg.run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         self._slide_step = end.next_step
@@ -304,7 +299,7 @@ class BearingSteps:
         clamped = {Event.LIFT_OFF: True, Event.CLAMP_END: False}.get(event, cs.clamped)
         if event == Event.SLIP_ZERO:
             self._v_rel_zero()
-        nxt = self._bearing_classify(st.held, cs.chi, 0.0, clamped)
+        nxt = self._bearing_classify(st.held, cs.chi, clamped)
         if nxt is None:
             self._bearing_lift_off()
         else:
