@@ -35,8 +35,9 @@ def _stream_from_the_seed_alone() -> Iterator[None]:
     of the core (a new constant in a module the test never reaches) changed which scenes a
     fixed-seed test explores: session 14 found two failing scenes that way (a
     negative dissipation at the rounding band of N, now bounded in the assertion; and a
-    grazing lift-off that ends flight after flight at ~1e-15 s until the work bound, open,
-    docs/benchmarks.md). Without the harvest every run and every tree replays one stream."""
+    grazing lift-off that ended flight after flight at ~1e-15 s until the work bound, fixed
+    in session 15, docs/model.md §3). Without the harvest every run and every tree replays
+    one stream."""
     try:
         from hypothesis.internal.conjecture import providers
     except ImportError:  # pragma: no cover (an older Hypothesis: nothing to switch off)

@@ -382,9 +382,10 @@ def test_illinois_takes_the_secant_of_f_minus_the_level() -> None:
 
 def test_the_modes_bound_the_third_derivative_of_the_gap() -> None:
     """Modes.g3_bound(s) bounds |g'''| of g = |z|^2 - c_r^2 at every later point of the
-    flight: on the random flights of 1000 with well-conditioned modes, at 20 points each, against
-    g3_exact from the state there. On some it is below the Taylor bound's slack alone
-    (where the search creeps, it is far below: the next test)."""
+    flight: on those of 1000 random flights whose modes are well conditioned (385), at 20
+    points each, against g3_exact from the state there (largest ratio 0.97). On some it is
+    below the Taylor bound's slack alone; where the search creeps it is far below (the next
+    test)."""
     rng = random.Random(20261127)
     checked = tighter = 0
     for _ in range(1000):

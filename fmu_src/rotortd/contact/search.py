@@ -64,7 +64,7 @@ CREEP = 2.0**-20
 """An advance shorter than CREEP times its interval is creeping: the Taylor bound of g'''
 (g3 plus the quartic slack) is loose there, by up to 1e9 where the orbit osculates the
 circle after a lift-off at N = 0 (flights of 7.5e-16 s until the work bound, found by the
-core fuzz), and the modes' bound is tried (ContactLocator._creep_step)."""
+core fuzz), and the modes' bound is tried (ContactLocator._creep_bound)."""
 CREEP_RUN = 16
 """Creeping advances of one search, the gap not closing (g' <= 0), before the modes' bound is
 tried: a flight that creeps along the wall does so for thousands; the short flights between

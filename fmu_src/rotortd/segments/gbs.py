@@ -19,9 +19,9 @@ side bound, or a caller's fused copy of it (contact.Sliding.midpoint_sweep)."""
 
 RHS_WORK = 2
 """Work units per right-hand side of an extrapolated contact integrator (the held sliding,
-the contact segments with the spin a state): one costs 2.2 us here, about twice a search
-advance's unit (measured: the held sliding at 2.2 us per right-hand side, the spin state's
-rolling at 1.1 us per unit; docs/model.md 7)."""
+the contact segments with the spin a state): a right-hand side costs about 2.2 us, two
+units of about 1.1 us (measured on the held sliding and the spin state's rolling;
+docs/model.md 7)."""
 STEP_WORK = 16
 """Work units per extrapolated step beyond its right-hand sides: the tableau, error norm,
 event test and step control (about 100 us at 9 columns, less at fewer)."""

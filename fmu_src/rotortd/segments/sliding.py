@@ -33,6 +33,8 @@ SCALE_FLOOR = 2.2250738585072014e-308
 forces (a 1e-313 N load, no spin, no stiffness) the scale RTOL * force * step underflowed
 to 0 and the error ratio divided by it (fuzzing). Far below any resolvable integral, it
 changes no scale that does not underflow."""
+
+
 class Sliding:
     """One sliding segment with slip sign ``slip`` from (theta0, dtheta0, E0)."""
 
