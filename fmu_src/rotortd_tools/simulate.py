@@ -185,13 +185,22 @@ def read_inputs(path: Path, variables: dict[str, Any]) -> Any:
 
 def _out_of_range(var: Any, values: list[float]) -> str:
     """'' if every value lies in var's declared range, else a message naming the first."""
-    lo, hi = _bound(var, "min"), _bound(var, "max")
     for i, x in enumerate(values):
-        if not lo <= x <= hi:
-            what = "is not finite" if x != x else "is out of range"
-            return (f"{var.name} = {x!r}{_unit(var, ' ')} in row {i + 1} {what}: it must lie "
-                    f"in [{lo:g}, {hi:g}]{_unit(var, ' ')}")
+        problem = _range_problem(var, x, repr(x), f" in row {i + 1}")
+        if problem:
+            return problem
     return ""
+
+
+def _range_problem(var: Any, value: float, shown: str, where: str = "") -> str:
+    """'' if value lies in var's declared range, else the message naming the variable, the
+    value as ``shown``, its unit, ``where`` it was given, and the range."""
+    lo, hi = _bound(var, "min"), _bound(var, "max")
+    if lo <= value <= hi:
+        return ""
+    what = "is not finite" if value != value else "is out of range"
+    return (f"{var.name} = {shown}{_unit(var, ' ')}{where} {what}: it must lie in "
+            f"[{lo:g}, {hi:g}]{_unit(var, ' ')}")
 
 
 def check_bearing(values: dict[str, Any], variables: dict[str, Any]) -> None:
@@ -259,11 +268,9 @@ def parse_value(var: Any, text: str) -> bool | int | float | str:
     except ValueError:
         raise UsageError(f"{var.name} = {text!r} is not {_article(kind)} {kind} value"
                          f"{_unit(var, ' in ')}") from None
-    lo, hi = _bound(var, "min"), _bound(var, "max")
-    if not lo <= value <= hi:
-        what = "is not finite" if value != value else "is out of range"
-        raise UsageError(f"{var.name} = {text}{_unit(var, ' ')} {what}: it must lie in "
-                         f"[{lo:g}, {hi:g}]{_unit(var, ' ')}")
+    problem = _range_problem(var, value, text)
+    if problem:
+        raise UsageError(problem)
     return value
 
 

@@ -135,11 +135,11 @@ class BearingSteps:
         self._bearing_at_circle(t0 + s_wall + st.s_lo, held, rep)
         return s_wall
 
-    def _bearing_at_circle(self, t: float, held: HeldInputs, rep: StepReport) -> bool:
+    def _bearing_at_circle(self, t: float, held: HeldInputs, rep: StepReport) -> None:
         """The flight reached the race's circle at t (s). Compliant law: the contact closes
         if the rotor moves (or, touching, accelerates) into the race. Rigid law: an impact
-        if it moves outward, then contact by the low-speed rule. False when it touched and
-        no contact force arises: the flight goes on."""
+        if it moves outward, then contact by the low-speed rule. Where it touched and no
+        contact force arises, the flight goes on."""
         race = self._race
         zb = race.centre()
         D = self._z - zb
@@ -148,15 +148,11 @@ class BearingSteps:
         rdot = (n.conjugate() * (self._v - race.velocity())).real
         model = BearingModel(held, self._law, ContactState(1.0))
         if self._law.compliant:
-            if rdot <= 0.0 and model.free_normal_acceleration(self._bearing_state()) <= 0.0:
-                return False
-            chi = self._c_d / max(rdot, V_FLOOR)
-            return self._bearing_enter(held, chi)
-        if rdot > 0.0:
-            if self._bearing_impact(t, n, rdot, held, rep):
-                self._bearing_enter(held, 0.0)
-            return True
-        return self._bearing_enter(held, 0.0)
+            if not (rdot <= 0.0
+                    and model.free_normal_acceleration(self._bearing_state()) <= 0.0):
+                self._bearing_enter(held, self._c_d / max(rdot, V_FLOOR))
+        elif not rdot > 0.0 or self._bearing_impact(t, n, rdot, held, rep):
+            self._bearing_enter(held, 0.0)
 
     def _bearing_impact(self, t: float, n: complex, rdot: float, held: HeldInputs,
                         rep: StepReport) -> bool:
@@ -199,15 +195,14 @@ class BearingSteps:
 
     # ------------------------------------------------------------------ contact
 
-    def _bearing_enter(self, held: HeldInputs, chi: float) -> bool:
+    def _bearing_enter(self, held: HeldInputs, chi: float) -> None:
         """Enter sustained contact from the state at the circle: the classifier's state, or
-        flight (False) when there is no contact force."""
+        flight on the wall when there is no contact force."""
         cs = self._bearing_classify(held, chi)
         if cs is None:
             self._on_wall = True
-            return False
-        self._bearing_set_contact(cs)
-        return True
+        else:
+            self._bearing_set_contact(cs)
 
     def _bearing_set_contact(self, cs: ContactState) -> None:
         self._cstate = cs
