@@ -53,6 +53,7 @@ _get_tunables = operator.attrgetter(*sorted(TUNABLE))
 _get_inputs = operator.attrgetter(*INPUTS)
 
 STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core-api.md)
+_INF = math.inf
 IMPACT_LOG_HEADER = "time,x,y,vx_minus,vy_minus,vx_plus,vy_plus,rdot,P_n,P_t,stick\n"
 
 
@@ -90,6 +91,20 @@ def publisher_source(fields: tuple[str, ...]) -> str:
             "    if events or _mode:\n        self.in_contact = _mode != 0\n"
             + "".join(f"        self.{by_field[f]} = _{f}\n" for f in fields
                       if f in ON_EVENTS))
+
+
+class _QuietReport:
+    """What ``_publish_step_outputs`` reads of a step taken in the core's quiet lane
+    (``TouchdownCore.quiet_step``): a flight proved clear, whose forces and impulses are
+    zero (as in its StepReport); T_imb is set per step."""
+
+    __slots__ = ("T_imb",)
+    F_contact = 0j
+    F_n = F_n_peak = P_n = T_f = 0.0
+    impacts = ()
+
+    def __init__(self) -> None:
+        self.T_imb = 0.0
 
 
 class ModelError(ValueError):
@@ -141,6 +156,9 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._h_spin_warned = False  # h_spin is deprecated: warned once if set
         self._spin_state = False  # the core's spin_is_state, read once per core
         self._race_outputs = False  # a real bearing's outputs to publish (core.race)
+        self._core_inputs: tuple | None = None  # _step_inputs as the core last took them
+        self._quiet = _QuietReport()  # the report of a step in the core's quiet lane
+        self._lane: Any = None  # the core's quiet lane while its steps are taken in it
 
     def _watched_setter(self, name: str) -> Any:
         """FMI setter of a parameter or input: stores the value and marks the values as
@@ -306,11 +324,23 @@ class RotorTouchdownAdapter(GuardedSlave):
         if self._changed:
             self._check_changes()
             self._changed = False
-        if not 0.0 < step_size < math.inf:
+        if not 0.0 < step_size < _INF:
             raise ModelError(f"communication step size {step_size!r} s must be finite "
                              f"and > 0")
-        tol = 1e-9 * max(1.0, abs(current_time)) + 1e-2 * step_size  # (_time_tolerance)
+        if self._step_inputs is self._core_inputs:  # the inputs the core holds
+            lane = self._lane or core.quiet_lane(step_size, _time_tolerance(0.0, step_size))
+            quiet = lane(core, current_time, step_size) if lane is not None else None
+            if quiet is not None:  # a step in the core's quiet lane
+                self._lane = lane
+                out, self._quiet.T_imb = quiet
+                self._publish(self, out, False)
+                total = sum(out) + self._publish_step_outputs(self._quiet)
+                if total - total != 0.0:
+                    self._refuse_non_finite()
+                return True
+        self._lane = None
         t = core.t
+        tol = _time_tolerance(current_time, step_size)
         if not abs(current_time - t) <= tol:  # also refuses a NaN or infinite time
             raise ModelError(f"communication point {current_time!r} does not match the "
                              f"model time {t!r}")
@@ -320,6 +350,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
         else:
             rep = core.step(step_size, omega, f_ext, amb)
+            self._core_inputs = self._step_inputs
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         # (the spin: the held input or the core's state)

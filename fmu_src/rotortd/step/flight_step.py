@@ -29,6 +29,7 @@ from __future__ import annotations
 import cmath
 import math
 from collections.abc import Callable
+from typing import Any, Protocol
 
 from ..contact.events import CLEAR, IMPACT
 from ..contact.impact import Impact, reset
@@ -200,9 +201,48 @@ class FlightSteps:
             self._envelope_at = math.inf
 
     def _forget_clear_proof(self) -> None:
-        """Forget the envelope proof: the state jumped or the inputs changed."""
+        """Forget the envelope proof, and the quiet lane built on it: the state jumped or
+        the inputs changed."""
         self._clear = False
         self._envelope_at = -math.inf
+        self._lane = None
+
+    _lane: QuietLane | None = None
+    """The quiet lane of the state (``quiet_lane``), None when it has none (forgotten with
+    the envelope proof)."""
+
+    def quiet_step(self, h: float) -> QuietStep | None:
+        """A step of h seconds under the held inputs of the last step, taken in the quiet
+        lane (``quiet_lane``): ``(output_values(), T_imb)`` at its end; None (nothing done)
+        when the state is not in the lane, and the caller takes ``step``."""
+        lane = self.quiet_lane(h)
+        return None if lane is None else lane(self, self._t, h)
+
+    def quiet_lane(self, h: float, t_tol: float = 0.0) -> QuietLane | None:
+        """The quiet lane for steps of h seconds from times within t_tol (s) of the
+        core's, or None when the state is not in it.
+
+        In the lane the state is in flight, proved clear of the wall for all time under the
+        held inputs (``_check_envelope``), with the spin held (J = inf), the bearing fixed
+        and rigid and the imbalance torque's coefficients for h cached: every step of h
+        under these inputs is then ``step``'s proved-free step (``_proved_free_step``). The
+        lane, ``lane(core, t, h)``, takes that step from the time t (s) and returns
+        ``(output_values(), T_imb)`` at its end, the same state and values as
+        ``step(h, *inputs)`` and then ``output_values()``, to the bit, without the step
+        report (its forces are zero) and without re-checking the held inputs (a declared
+        accelerator: ``make_quiet_lane``). It returns None, doing nothing, once the core has
+        left it (new inputs or parameters, a state set, a step that was not proved free),
+        for another h, with the imbalance torque off, or when t is not the core's time to
+        within t_tol (a host's clock: the host's own check then runs on its general path);
+        a host may keep it while it answers."""
+        lane = self._lane
+        if lane is not None and lane.h == h and lane.t_tol == t_tol:
+            return lane
+        if not (self._clear and self._imb_free_h == h and self._J == INF
+                and self._race is None and self._inputs[0] != 0.0):
+            return None
+        self._lane = lane = make_quiet_lane(self, h, t_tol)
+        return lane
 
     def _impact(self, t: float, z: complex, v_minus: complex, rep: StepReport) -> None:
         p = self._p
@@ -301,3 +341,93 @@ def starts_contact(A: float, vb: float, d: float, c_r: float,
     if d < 1.0 and v1 > 0.0 and math.log(vb / v1) < -N_CASCADE * math.log(d):
         return False
     return 2.0 * vb / A <= ETA_TIME / w_ref()
+
+
+QuietStep = tuple[tuple[Any, ...], float]
+"""What a step in the quiet lane returns: (``output_values()``, T_imb in N m)."""
+
+
+class QuietLane(Protocol):
+    """``lane(core, t, h)``: one step of h s from t (s) in the quiet lane
+    (``FlightSteps.quiet_lane``)."""
+
+    h: float
+    t_tol: float
+
+    def __call__(self, core: Any, t: float, h: float) -> QuietStep | None: ...
+
+
+def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
+    """The quiet lane of ``core`` (a TouchdownCore whose state is in it: ``quiet_lane``)
+    for steps of h seconds from times within t_tol (s) of the core's: ``lane(core, t, h)``
+    advances it by one proved-free step and returns ``(core.output_values(), T_imb)``, or
+    None while the core is not in it.
+
+    A declared accelerator: ``_proved_free_step`` (the flight map ``FlightModel.propagate``,
+    the cached impulse of ``_imb_flight``, ``_add_psi``), ``TouchdownCore._finish`` (the
+    compensated clock) and ``TouchdownCore.output_values`` (in flight), inlined with the
+    held inputs' constants bound once, each product formed as there, so the state and
+    every output are the same to the bit (tests/test_quiet_lane.py checks it at random
+    states against those definitions). Issue 26 item 3: a levitated step at constant
+    inputs costs what its arithmetic costs (docs/benchmarks.md, "Quiet steps")."""
+    W, _F, a = core._inputs
+    fm, p = core._fm, core._p
+    co = fm.coeffs(h, cache=True)
+    F1, fz, fv = fm.F1, fm.f0 * co.qz0, fm.f0 * co.qv0
+    # (complex(x) * z has the bits of x * z, which CPython computes as complex(x) * z after
+    # float.__mul__ declines)
+    p11, p12, p21, p22 = complex(co.p11), complex(co.p12), complex(co.p21), complex(co.p22)
+    qzs, qvs = co.qzs, co.qvs
+    bz, bv, b0, bE = core._imb_free
+    dpsi, iW, c_r, den, RW = W * h, 1j * W, p.c_r, p.c_r * W, p.R * W
+    bias, c, k, a = core._bias_force, complex(p.c), complex(p.k), complex(a)
+    mode, n_imp, t_last, v_last, E_diss = (core._mode, core._n_impacts, core._t_last,
+                                           core._v_last, core._E_diss)  # (fixed in flight)
+    exp, floor, pi, neg_pi = cmath.exp, math.floor, math.pi, -math.pi
+
+    def lane(core: Any, t_start: float, h_: float) -> QuietStep | None:
+        t0 = core._t
+        if (core._lane is not lane or h_ != h or not abs(t_start - t0) <= t_tol
+                or not core.imbalance_torque):
+            return None
+        psi, z0, v0 = core._psi, core._z, core._v
+        E = core._E_at if core._E_of is psi else exp(1j * psi)
+        g = F1 * E
+        z = p11 * z0 + p12 * v0 + fz + g * qzs
+        v = p21 * z0 + p22 * v0 + fv + g * qvs
+        P = (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
+        x = psi + dpsi
+        q = (x + pi) / TWO_PI_HI
+        if not 0.0 <= q < 1.0:  # (_add_psi's n = floor(q) is not 0; NaN cannot occur)
+            n = floor(q)
+            x = (x - n * TWO_PI_HI) - n * TWO_PI_LO
+            core._turns += n
+        y = h - core._t_lo
+        t = t0 + y
+        core._t_lo = (t - t0) - y
+        core._t = t
+        core._z = z
+        core._v = v
+        core._psi = x
+        core._E_at = E = exp(1j * x)
+        core._E_of = x
+        rot = E.conjugate()
+        U = z * rot
+        dU = (v - iW * z) * rot / den
+        if dU - dU != 0j:
+            dU = 0j
+        r = abs(z)
+        rr = r * r
+        x_ = z.real
+        y_ = z.imag
+        vx = v.real
+        vy = v.imag
+        cross = x_ * vy - y_ * vx
+        whirl = cross / rr if rr > 0.0 else (cross / r) / r if r > 0.0 else 0.0
+        F = a * (bias - c * v - k * z)
+        return (x_, y_, vx, vy, r / c_r, U.real / c_r, U.imag / c_r,
+                dU.real, dU.imag, -x if x == neg_pi else x, whirl, RW + c_r * whirl,
+                F.real, F.imag, W, mode, n_imp, t_last, v_last, E_diss), P / h
+
+    lane.h, lane.t_tol = h, t_tol  # type: ignore[attr-defined]
+    return lane  # type: ignore[return-value]
