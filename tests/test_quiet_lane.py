@@ -149,17 +149,35 @@ def test_the_fmu_in_the_lane_publishes_what_the_core_steps_give() -> None:
     ref = TouchdownCore.on_steady_whirl(slave._core.params, 184.2)
     fields = ref.outputs()._fields
     omega_vr = next(v.value_reference for v in slave.vars.values() if v.name == "Omega")
-    h, lanes, offered = 1e-3, 0, 0
+    h, lanes = 1e-3, 0
     for j in range(60):
         if j == 30:
             slave.set_real([omega_vr], [184.0])
-        offered += j != 30 and ref.quiet_lane(h) is not None  # (the set: a general step)
+        held = slave._lane is not None and j != 30  # (a set: the general step)
+        assert held == (j != 30 and ref.quiet_lane(h) is not None), j
+        lanes += held
         assert slave.do_step(j * h, h)
         rep = ref.step(h, 184.2 if j < 30 else 184.0)
-        lanes += slave._lane is not None
         want = dict(zip(fields, ref.output_values()))
         for var in tv.TABLE:
             if var.shows:
                 assert getattr(slave, var.name) == want[var.shows], (j, var.name)
         assert slave.T_imb == rep.T_imb, j
-    assert lanes == offered >= 50  # taken whenever the core offers it
+    assert lanes >= 50  # taken whenever the core offers it (above), which is most steps
+
+
+def test_a_host_clock_rounding_its_steps_gets_the_steps_of_its_length() -> None:
+    """libcosim passes differences of integer-ns times as step sizes, 1e-3 s jittering by a
+    few ulps of the time: such a step is the step length taken before (``_host_step``), so
+    the run is the one at exact steps, to the bit, and in the lane; a real change of the
+    step size is taken as it is."""
+    exact, jittery = _slave(), _slave()
+    h = 1e-3
+    for j in range(400):
+        t = j * h
+        assert exact.do_step(exact._core.t, h)
+        assert jittery.do_step(t, ((j + 1) * 1_000_000) * 1e-9 - (j * 1_000_000) * 1e-9)
+    assert jittery._core.get_state() == exact._core.get_state()
+    assert jittery._lane is not None
+    t = jittery._core.t
+    assert jittery.do_step(t, 2e-3) and abs(jittery._core.t - (t + 2e-3)) <= 1e-15

@@ -71,8 +71,12 @@ class GuardedSlave(Fmi2Slave):
         try:
             return self._step(current_time, step_size)
         except Exception as exc:
-            self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
+            self._step_failed(current_time, step_size, exc)
             return False
+
+    def _step_failed(self, current_time: float, step_size: float, exc: Exception) -> None:
+        """Fail the instance with the exception that stopped a step."""
+        self._fail(f"do_step at t={current_time!r}, h={step_size!r} failed: {exc}")
 
     def _output_setter(self, name: str) -> Any:
         """fmi2SetReal on an output: FMI's answer is fmi2Error, which PythonFMU cannot

@@ -54,6 +54,10 @@ _get_inputs = operator.attrgetter(*INPUTS)
 
 STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core-api.md)
 _INF = math.inf
+_EPS = 2.220446049250313e-16
+HOST_STEP_ULPS = 8.0
+"""A host's step within HOST_STEP_ULPS eps of its time of the last step taken is that step
+(``RotorTouchdownAdapter._host_step``)."""
 IMPACT_LOG_HEADER = "time,x,y,vx_minus,vy_minus,vx_plus,vy_plus,rdot,P_n,P_t,stick\n"
 
 
@@ -156,9 +160,9 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._h_spin_warned = False  # h_spin is deprecated: warned once if set
         self._spin_state = False  # the core's spin_is_state, read once per core
         self._race_outputs = False  # a real bearing's outputs to publish (core.race)
-        self._core_inputs: tuple | None = None  # _step_inputs as the core last took them
         self._quiet = _QuietReport()  # the report of a step in the core's quiet lane
-        self._lane: Any = None  # the core's quiet lane while its steps are taken in it
+        self._lane: Any = None  # the core's quiet lane, while held (do_step)
+        self._h_taken = math.nan  # the last step size taken (s): _host_step
 
     def _watched_setter(self, name: str) -> Any:
         """FMI setter of a parameter or input: stores the value and marks the values as
@@ -279,6 +283,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         """Make the next step validate every group (after initialisation or a restore)."""
         self._seen_fixed = self._seen_tunables = self._seen_inputs = None
         self._changed = True
+        self._h_taken = math.nan
 
     def _check_inputs(self) -> None:
         self._require_ranges(INPUTS)
@@ -327,18 +332,8 @@ class RotorTouchdownAdapter(GuardedSlave):
         if not 0.0 < step_size < _INF:
             raise ModelError(f"communication step size {step_size!r} s must be finite "
                              f"and > 0")
-        if self._step_inputs is self._core_inputs:  # the inputs the core holds
-            lane = self._lane or core.quiet_lane(step_size, _time_tolerance(0.0, step_size))
-            quiet = lane(core, current_time, step_size) if lane is not None else None
-            if quiet is not None:  # a step in the core's quiet lane
-                self._lane = lane
-                out, self._quiet.T_imb = quiet
-                self._publish(self, out, False)
-                total = sum(out) + self._publish_step_outputs(self._quiet)
-                if total - total != 0.0:
-                    self._refuse_non_finite()
-                return True
-        self._lane = None
+        if step_size != self._h_taken:
+            step_size = self._host_step(current_time, step_size)
         t = core.t
         tol = _time_tolerance(current_time, step_size)
         if not abs(current_time - t) <= tol:  # also refuses a NaN or infinite time
@@ -350,7 +345,6 @@ class RotorTouchdownAdapter(GuardedSlave):
             rep = core.step(step_size, F_ext=f_ext, amb_on=amb, T_drive=t_drive)
         else:
             rep = core.step(step_size, omega, f_ext, amb)
-            self._core_inputs = self._step_inputs
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         # (the spin: the held input or the core's state)
@@ -360,9 +354,58 @@ class RotorTouchdownAdapter(GuardedSlave):
             total += self._publish_race(rep)
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
+        self._h_taken = step_size
         if rep.status == 0 and abs(core.t - t_target) <= tol:
+            if not self._spin_state:  # the next steps in the quiet lane, if the state is in it
+                self._lane = core.quiet_lane(step_size, _time_tolerance(0.0, step_size))
             return True  # the common case, without a call
         return self._judge_report(rep, t_target, tol)
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        """A step in the core's quiet lane (``TouchdownCore.quiet_lane``) while it is held,
+        else the guarded step (``GuardedSlave.do_step`` -> ``_step``). The lane is held
+        after a completed step whose state it takes, and dropped by any FMI setter
+        (``_changed``), a failure or terminate (``_fail``, ``terminate``) and by a step it
+        declines (another step size, a host clock off the model time, the core changed);
+        so a lane step needs none of ``_step``'s checks: its inputs and parameters are
+        those the last step validated, and the lane checks h and the clock itself."""
+        lane = self._lane
+        if lane is not None:
+            if not self._changed:
+                try:
+                    quiet = lane(self._core, current_time, step_size if step_size ==
+                                 self._h_taken else self._host_step(current_time, step_size))
+                    if quiet is not None:
+                        out, self._quiet.T_imb = quiet
+                        self._publish(self, out, False)
+                        total = sum(out) + self._publish_step_outputs(self._quiet)
+                        if total - total != 0.0:
+                            self._refuse_non_finite()
+                        return True
+                except Exception as exc:
+                    self._step_failed(current_time, step_size, exc)
+                    return False
+            self._lane = None
+        return super().do_step(current_time, step_size)
+
+    def _host_step(self, t: float, step_size: float) -> float:
+        """The step to take for the host's step_size at its time t (s): the last one taken
+        when they differ by no more than the rounding of the host's clock (HOST_STEP_ULPS
+        eps of t or of the step: libcosim's steps of 1e-3 s, differences of times in
+        integer ns, jitter by 3e-16 s at t = 2 s), so that a recurring step stays one
+        length for the core's caches and the quiet lane; else step_size."""
+        h = self._h_taken
+        if abs(step_size - h) <= HOST_STEP_ULPS * _EPS * max(abs(t), step_size):
+            return h
+        return step_size
+
+    def _fail(self, msg: str) -> None:
+        self._lane = None
+        super()._fail(msg)
+
+    def terminate(self) -> None:
+        self._lane = None
+        super().terminate()
 
     def _refuse_non_finite(self) -> None:
         """Raise (the step is refused) if an output is NaN or infinite: no non-finite

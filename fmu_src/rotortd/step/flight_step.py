@@ -384,14 +384,16 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
     mode, n_imp, t_last, v_last, E_diss = (core._mode, core._n_impacts, core._t_last,
                                            core._v_last, core._E_diss)  # (fixed in flight)
     exp, floor, pi, neg_pi = cmath.exp, math.floor, math.pi, -math.pi
+    E_of, E_at = core._E_of, core._E_at
 
     def lane(core: Any, t_start: float, h_: float) -> QuietStep | None:
         t0 = core._t
         if (core._lane is not lane or h_ != h or not abs(t_start - t0) <= t_tol
                 or not core.imbalance_torque):
             return None
+        nonlocal E_of, E_at
         psi, z0, v0 = core._psi, core._z, core._v
-        E = core._E_at if core._E_of is psi else exp(1j * psi)
+        E = E_at if psi is E_of else exp(1j * psi)  # (the phasor of the last lane step)
         g = F1 * E
         z = p11 * z0 + p12 * v0 + fz + g * qzs
         v = p21 * z0 + p22 * v0 + fv + g * qvs
@@ -409,8 +411,8 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
         core._z = z
         core._v = v
         core._psi = x
-        core._E_at = E = exp(1j * x)
-        core._E_of = x
+        E_at = E = exp(1j * x)  # (not kept on the core: a step off the lane computes it)
+        E_of = x
         rot = E.conjugate()
         U = z * rot
         dU = (v - iW * z) * rot / den
