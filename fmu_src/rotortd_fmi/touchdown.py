@@ -55,6 +55,9 @@ _get_inputs = operator.attrgetter(*INPUTS)
 STATUS_WORK_CAP = 1  # rotortd.STATUS_WORK_CAP: the step stopped early (see core-api.md)
 _INF = math.inf
 _EPS = 2.220446049250313e-16
+CLOCK_STEPS = 1e-2
+"""A host's communication point may be off the model time by CLOCK_STEPS of the step (plus
+1e-9 of the time: ``_time_tolerance``)."""
 HOST_STEP_ULPS = 8.0
 """A host's step within HOST_STEP_ULPS eps of its time of the last step taken is that step
 (``RotorTouchdownAdapter._host_step``)."""
@@ -119,7 +122,7 @@ def _time_tolerance(t: float, step_size: float) -> float:
     """Allowed gap between the host's communication point and the model time: host clocks
     that add h up naively drift by rounding (the core's clock is compensated); a gap of a
     sizeable fraction of a step means a skipped, repeated or rolled-back step."""
-    return 1e-9 * max(1.0, abs(t)) + 1e-2 * step_size
+    return 1e-9 * max(1.0, abs(t)) + CLOCK_STEPS * step_size
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -348,16 +351,16 @@ class RotorTouchdownAdapter(GuardedSlave):
         if self.impact_log and rep.impacts:
             self._append_impacts(rep.impacts)
         # (the spin: the held input or the core's state)
-        total = (self._publish_state(None, amb, bool(rep.impacts or rep.transitions))
-                 + self._publish_step_outputs(rep))
+        events = bool(rep.impacts or rep.transitions)
+        total = self._publish_state(None, amb, events) + self._publish_step_outputs(rep)
         if self._race_outputs:  # a real bearing (docs/model.md §10)
             total += self._publish_race(rep)
         if total - total != 0.0:  # inf or NaN somewhere (or an overflowing sum: checked)
             self._refuse_non_finite()
         self._h_taken = step_size
         if rep.status == 0 and abs(core.t - t_target) <= tol:
-            if not self._spin_state:  # the next steps in the quiet lane, if the state is in it
-                self._lane = core.quiet_lane(step_size, _time_tolerance(0.0, step_size))
+            if not (events or self._spin_state):  # the quiet lane, if the state is in it
+                self._lane = core.quiet_lane(step_size, CLOCK_STEPS * step_size)
             return True  # the common case, without a call
         return self._judge_report(rep, t_target, tol)
 
@@ -386,7 +389,7 @@ class RotorTouchdownAdapter(GuardedSlave):
                     self._step_failed(current_time, step_size, exc)
                     return False
             self._lane = None
-        return super().do_step(current_time, step_size)
+        return GuardedSlave.do_step(self, current_time, step_size)
 
     def _host_step(self, t: float, step_size: float) -> float:
         """The step to take for the host's step_size at its time t (s): the last one taken

@@ -384,25 +384,29 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
     mode, n_imp, t_last, v_last, E_diss = (core._mode, core._n_impacts, core._t_last,
                                            core._v_last, core._E_diss)  # (fixed in flight)
     exp, floor, pi, neg_pi = cmath.exp, math.floor, math.pi, -math.pi
-    E_of, E_at = core._E_of, core._E_at
+    E_of, E_at, Ec_at = None, 0j, 0j
 
     def lane(core: Any, t_start: float, h_: float) -> QuietStep | None:
         t0 = core._t
         if (core._lane is not lane or h_ != h or not abs(t_start - t0) <= t_tol
                 or not core.imbalance_torque):
             return None
-        nonlocal E_of, E_at
+        nonlocal E_of, E_at, Ec_at
         psi, z0, v0 = core._psi, core._z, core._v
-        E = E_at if psi is E_of else exp(1j * psi)  # (the phasor of the last lane step)
+        if psi is E_of:  # (the phasor of the last lane step and its conjugate)
+            E, Ec = E_at, Ec_at
+        else:
+            E = exp(1j * psi)
+            Ec = E.conjugate()
         g = F1 * E
         z = p11 * z0 + p12 * v0 + fz + g * qzs
         v = p21 * z0 + p22 * v0 + fv + g * qvs
-        P = (E.conjugate() * (bz * z0 + bv * v0 + b0)).imag + bE
+        P = (Ec * (bz * z0 + bv * v0 + b0)).imag + bE
         x = psi + dpsi
-        q = (x + pi) / TWO_PI_HI
-        if not 0.0 <= q < 1.0:  # (_add_psi's n = floor(q) is not 0; NaN cannot occur)
-            n = floor(q)
-            x = (x - n * TWO_PI_HI) - n * TWO_PI_LO
+        q = x + pi
+        if not 0.0 <= q < TWO_PI_HI:  # (_add_psi's floor(q / TWO_PI_HI) is not 0: the
+            n = floor(q / TWO_PI_HI)  # quotient of a correctly rounded division is >= 1
+            x = (x - n * TWO_PI_HI) - n * TWO_PI_LO  # exactly when q >= TWO_PI_HI)
             core._turns += n
         y = h - core._t_lo
         t = t0 + y
@@ -413,7 +417,7 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
         core._psi = x
         E_at = E = exp(1j * x)  # (not kept on the core: a step off the lane computes it)
         E_of = x
-        rot = E.conjugate()
+        Ec_at = rot = E.conjugate()
         U = z * rot
         dU = (v - iW * z) * rot / den
         if dU - dU != 0j:
