@@ -5,7 +5,9 @@ The FMU's script ``fmu_src/RotorTouchdown.py`` only subclasses ``RotorTouchdownA
 A thin layer over the physics core ``rotortd`` (see docs/core-api.md). It declares the FMI
 variables, validates parameters and inputs, hands each communication step to
 ``TouchdownCore.step`` and publishes the step report (what happened over the step) and
-``TouchdownCore.output_values`` (what the state shows at its end).
+``TouchdownCore.output_values`` (what the state shows at its end). While the state is in the
+core's quiet lane (``TouchdownCore.quiet_lane``: a levitated whirl proved clear at held
+inputs), ``do_step`` takes the step in it with one call (docs/architecture.md, frame 0).
 
 Rules this file follows (see the project's FMI notes):
 - ``__init__`` is cheap and free of side effects (the builder instantiates the class).
@@ -102,7 +104,7 @@ def publisher_source(fields: tuple[str, ...]) -> str:
 
 class _QuietReport:
     """What ``_publish_step_outputs`` reads of a step taken in the core's quiet lane
-    (``TouchdownCore.quiet_step``): a flight proved clear, whose forces and impulses are
+    (``TouchdownCore.quiet_lane``): a flight proved clear, whose forces and impulses are
     zero (as in its StepReport); T_imb is set per step."""
 
     __slots__ = ("T_imb",)
@@ -403,10 +405,12 @@ class RotorTouchdownAdapter(GuardedSlave):
         return step_size
 
     def _fail(self, msg: str) -> None:
+        """GuardedSlave._fail, and the quiet lane dropped (do_step)."""
         self._lane = None
         super()._fail(msg)
 
     def terminate(self) -> None:
+        """GuardedSlave.terminate, and the quiet lane dropped (do_step)."""
         self._lane = None
         super().terminate()
 
