@@ -181,3 +181,25 @@ def test_a_host_clock_rounding_its_steps_gets_the_steps_of_its_length() -> None:
     assert jittery._lane is not None
     t = jittery._core.t
     assert jittery.do_step(t, 2e-3) and abs(jittery._core.t - (t + 2e-3)) <= 1e-15
+
+
+def test_a_restored_state_steps_as_it_did_from_the_lane() -> None:
+    """An FMU state saved while the lane is held, restored after more lane steps: the
+    steps from it repeat the first ones to the bit (the restore drops the lane; the steps
+    after it take the general path, then the lane again)."""
+    slave = _slave()
+    h = 1e-3
+    for _ in range(10):
+        assert slave.do_step(slave._core.t, h)
+    assert slave._lane is not None
+    saved = slave._get_fmu_state()
+    first = []
+    for _ in range(10):
+        assert slave.do_step(slave._core.t, h)
+        first.append((slave.x, slave.y, slave.T_imb, slave.psi))
+    slave._set_fmu_state(saved)
+    again = []
+    for _ in range(10):
+        assert slave.do_step(slave._core.t, h)
+        again.append((slave.x, slave.y, slave.T_imb, slave.psi))
+    assert again == first and slave._lane is not None
