@@ -135,22 +135,20 @@ def check_lean(sc: B.Scene, n: int = 1000) -> float:
                for f, a, b in zip(fields, got, ref) if a != b)
 
 
-def lean_template(consts: dict[str, Any]) -> str:
-    """The floor FMU's slave module with the lean do_step in place of the floor's."""
+def lean_template(consts: dict[str, Any], start: tuple) -> str:
+    """The floor FMU's slave module with the lean do_step in place of the floor's, its
+    state (z, v, psi, t, t_lo) starting at ``start``."""
     floor = B.FLOOR_TEMPLATE.format(**B._adapter_tables())
     marker = "    def do_step(self, current_time, step_size):\n"
     head, tail = floor.split(marker)
     rest = tail.split("\n    def _publish_state", 1)[1]
     start = ("\n    def exit_initialization_mode(self):\n"
-             f"        self._lean = {START!r}\n        return True\n")
+             f"        self._lean = {start!r}\n        return True\n")
     return (prelude(consts) + head + LEAN_STEP.lstrip("\n") + start
             + "\n    def _publish_state" + rest)
 
 
-START: tuple = ()
-
-
-def build_lean(tmp: Path, consts: dict[str, Any]) -> tuple[str, Any]:
+def build_lean(tmp: Path, consts: dict[str, Any], start: tuple) -> tuple[str, Any]:
     """Build the lean FMU into tmp (as benchmarks.build_fmus builds the floor)."""
     from fmpy import extract, read_model_description
 
@@ -159,7 +157,7 @@ def build_lean(tmp: Path, consts: dict[str, Any]) -> tuple[str, Any]:
     pkg = tmp / "rotortd_floor_lean"
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
-    (pkg / "slave.py").write_text(lean_template(consts))
+    (pkg / "slave.py").write_text(lean_template(consts, start))
     script = tmp / "RotorTouchdownLean.py"
     script.write_text(B.FLOOR_SCRIPT.replace("rotortd_floor", "rotortd_floor_lean")
                       .replace("RotorTouchdownFloor(", "RotorTouchdownLean("))
@@ -169,7 +167,6 @@ def build_lean(tmp: Path, consts: dict[str, Any]) -> tuple[str, Any]:
 
 
 def main() -> None:
-    global START
     sc = next(s for s in B.make_scenes() if s.name == "free_whirl")
     err = check_lean(sc)
     print(f"lean step against the core after 1000 steps: largest relative difference "
@@ -179,11 +176,11 @@ def main() -> None:
     core = TouchdownCore(sc.params, z0=sc.z0, v0=sc.v0, psi0=sc.psi0)
     core.step(H, B.W, 0j, 1.0)  # (the held inputs set; the whirl is proved clear)
     consts = lean_constants(core, H)
-    START = (core._z, core._v, core._psi, core._t, core._t_lo)
+    start = (core._z, core._v, core._psi, core._t, core._t_lo)
     with tempfile.TemporaryDirectory() as tmp_name:
         tmp = Path(tmp_name)
         fmus = B.build_fmus(tmp)
-        fmus["RotorTouchdownLean"] = build_lean(tmp, consts)
+        fmus["RotorTouchdownLean"] = build_lean(tmp, consts, start)
         data: dict[str, Any] = {"outputs": (B.REAL_OUT, B.INT_OUT, B.BOOL_OUT),
                                 "free_whirl": B.start_values(sc)}
         names = {"fmu": "RotorTouchdown", "floor": "RotorTouchdownFloor",
