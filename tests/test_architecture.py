@@ -67,3 +67,19 @@ def test_loc_counts_logical_lines() -> None:
               'def f(x: float) -> float:\n    """Doc."""\n    s = """not a\n    docstring"""\n'
               '    return (math.sin(x)  # trailing comment\n            + len(s))\n')
     assert loc.count(source) == (13, 6)
+
+
+def test_loc_groups_partition_the_core() -> None:
+    """docs/scripts/loc.py --groups: every entry of its GROUPS names a file or definition
+    that exists (else it exits), and the groups with "the rest" add up to the whole count."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("loc", SRC.parent / "docs/scripts/loc.py")
+    assert spec and spec.loader
+    loc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(loc)
+    groups = loc.group_counts(SRC / "rotortd")
+    _, _, total = loc.tree_counts(loc.worktree_files(SRC / "rotortd"))
+    assert sum(groups.values()) == total
+    assert all(n > 0 for n in groups.values()), groups
+    assert loc.definition_lines("class A:\n    def f(self):\n        pass\n", "f") == {2, 3}
