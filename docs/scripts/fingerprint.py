@@ -20,8 +20,8 @@ communication step, is recorded to the last bit:
   name, floats as ``float.hex``;
 - the job's tag: the segment kinds it passed through, with counts (TAGS: P proved-free
   flight, F searched flight, S sliding, R rolling, L/Q/K the linear, quadratic and locked
-  rub; with the spin as a state C closed-form flight, I integrated flight, s sliding, r
-  rolling), and a summary: impacts, contact time (from the transitions' times), the
+  rub; with the spin as a state C closed-form flight, I integrated flight, q the quiet
+  step (integrated, proved clear at once), s sliding, r rolling), and a summary: impacts, contact time (from the transitions' times), the
   largest r/c_r at the steps' ends, the steps ending in each mode, nonzero statuses.
 
 The FMU (built from each tree with its own build.py) runs a few scenes through FMPy's
@@ -543,7 +543,8 @@ def _wrap_run(cls: type, kind: Callable[[Any], str]) -> None:
 TAGS = {"P": "proved-free flight", "F": "searched flight", "S": "sliding (integrated)",
         "R": "rolling (closed form)", "L": "rub, linear", "Q": "rub, quadratic",
         "K": "rub, locked", "C": "spin: closed-form flight", "I": "spin: integrated flight",
-        "s": "spin: sliding", "r": "spin: rolling", "f": "flight (no hook)",
+        "s": "spin: sliding", "r": "spin: rolling", "q": "spin: quiet step (integrated)",
+        "f": "flight (no hook)",
         "d": "sliding (no hook)", "o": "rolling (no hook)"}
 """Segment kinds a job passed through (its tag), by code."""
 CLOSED_FORM = frozenset("PRLQK")
@@ -554,12 +555,13 @@ _MODE_OF_NAME = (("lift", 0), ("free", 0), ("slid", 1), ("roll", 2))
 
 
 def step_kinds(logged: list[str], hooked: bool, mode0: int, mode1: int,
-               transitions: list[Any]) -> list[str]:
+               transitions: list[Any], quiet: str = "P") -> list[str]:
     """The segment kinds of one step: the hook's log; a hooked step that ran no segment
-    from flight is one proved-free flight (TouchdownCore's whole step); unhooked, the
-    modes the step passed through (start, transitions, end)."""
+    from flight is one quiet step, ``quiet`` (P: the held core's proved-free whole step;
+    q: the spin state's quiet step); unhooked, the modes the step passed through (start,
+    transitions, end)."""
     if hooked:
-        return logged or (["P"] if mode0 == 0 else [])
+        return logged or ([quiet] if mode0 == 0 else [])
     modes = {mode0, mode1, *(_mode_of(tr[1]) for tr in transitions if len(tr) > 1)}
     return [_PUBLIC_KIND[m] for m in sorted(m for m in modes if m in _PUBLIC_KIND)]
 
@@ -716,11 +718,12 @@ class Recorder:
     the steps' ends), largest |z|/c_r at the steps' ends, steps ending in each mode, steps
     with a nonzero status."""
 
-    def __init__(self, c_r: float = 1.0, hooked: bool = False, mode0: int = 0) -> None:
+    def __init__(self, c_r: float = 1.0, hooked: bool = False, mode0: int = 0,
+                 quiet: str = "P") -> None:
         self.rows = array.array("d")
         self.imps = array.array("d")
         self.trs = array.array("d")
-        self.c_r, self.hooked, self.mode = c_r, hooked, mode0
+        self.c_r, self.hooked, self.mode, self.quiet = c_r, hooked, mode0, quiet
         self.tags: dict[str, int] = {}
         self.summary = {"duration": 0.0, "impacts": 0, "contact_time": 0.0, "max_r": 0.0,
                         "modes": [0, 0, 0], "bad_status": 0}
@@ -735,7 +738,7 @@ class Recorder:
         for tr in trs:
             self.trs.extend(transition_row(k, tr))
         mode1 = _mode_int(now.get("mode"))
-        for kind in step_kinds(logged, self.hooked, self.mode, mode1, list(trs)):
+        for kind in step_kinds(logged, self.hooked, self.mode, mode1, list(trs), self.quiet):
             self.tags[kind] = self.tags.get(kind, 0) + 1
         self._summarise(now, rep, h, list(trs), mode1)
 
@@ -781,7 +784,7 @@ def record_core_job(rotortd: Any, spec: Spec, label: str, out: Path,
     """Record one core job; return its summary (hash, final state, counters, tag)."""
     t0 = time.perf_counter()
     z0, v0 = start_of(spec)
-    rec = Recorder(_fx(spec["params"]["c_r"]), hooked)
+    rec = Recorder(_fx(spec["params"]["c_r"]), hooked, quiet="q" if is_spin(spec) else "P")
     ad = run_core(rotortd, spec, label, z0, v0, rec.core_step,
                   lambda now: setattr(rec, "mode", _mode_int(now.get("mode"))))
     return {"hash": rec.save(out, job_name("core", spec["name"], label)),

@@ -107,13 +107,14 @@ class _QuietReport:
     (``TouchdownCore.quiet_lane``): a flight proved clear, whose forces and impulses are
     zero (as in its StepReport); T_imb is set per step."""
 
-    __slots__ = ("T_imb",)
+    __slots__ = ("T_f", "T_imb")
     F_contact = 0j
-    F_n = F_n_peak = P_n = T_f = 0.0
+    F_n = F_n_peak = P_n = 0.0
     impacts = ()
 
-    def __init__(self) -> None:
+    def __init__(self, T_f: float = 0.0) -> None:
         self.T_imb = 0.0
+        self.T_f = T_f  # (-0.0 with the spin a state: -R * 0.0 / h, as its StepReport)
 
 
 class ModelError(ValueError):
@@ -158,6 +159,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         # values the last step found valid: a step re-checks only what changed since,
         # and nothing unless an FMI setter (or initialisation, or a state restore) ran
         self._changed = True
+        self._T_only = False  # and what changed since is T_drive alone (the spin's lane)
         self._step_inputs: tuple[float, complex, float, float] = (0.0, 0j, 1.0, 0.0)
         self._seen_fixed: tuple | None = None
         self._seen_tunables: tuple | None = None
@@ -166,6 +168,9 @@ class RotorTouchdownAdapter(GuardedSlave):
         self._spin_state = False  # the core's spin_is_state, read once per core
         self._race_outputs = False  # a real bearing's outputs to publish (core.race)
         self._quiet = _QuietReport()  # the report of a step in the core's quiet lane
+        self._quiet_spin = _QuietReport(-0.0)  # the same with the spin a state
+        t_drive = tv.BY_NAME["T_drive"]
+        self._T_range = (t_drive.lo, t_drive.hi)  # (N m) its declared range
         self._lane: Any = None  # the core's quiet lane, while held (do_step)
         self._h_taken = math.nan  # the last step size taken (s): _host_step
 
@@ -174,6 +179,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         changed, so the next step validates them (and only then)."""
         def store(value: Any) -> None:
             setattr(self, name, value)
+            self._T_only = name == "T_drive" and (self._T_only or not self._changed)
             self._changed = True
             if name == "h_spin" and not self._h_spin_warned:
                 self._h_spin_warned = True
@@ -288,6 +294,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         """Make the next step validate every group (after initialisation or a restore)."""
         self._seen_fixed = self._seen_tunables = self._seen_inputs = None
         self._changed = True
+        self._T_only = False
         self._h_taken = math.nan
 
     def _check_inputs(self) -> None:
@@ -333,7 +340,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             raise ModelError("do_step before exitInitializationMode")
         if self._changed:
             self._check_changes()
-            self._changed = False
+            self._changed = self._T_only = False
         if not 0.0 < step_size < _INF:
             raise ModelError(f"communication step size {step_size!r} s must be finite "
                              f"and > 0")
@@ -361,7 +368,7 @@ class RotorTouchdownAdapter(GuardedSlave):
             self._refuse_non_finite()
         self._h_taken = step_size
         if rep.status == 0 and abs(core.t - t_target) <= tol:
-            if not (events or self._spin_state):  # the quiet lane, if the state is in it
+            if not events:  # the quiet lane, if the state is in it
                 self._lane = core.quiet_lane(step_size, CLOCK_STEPS * step_size)
             return True  # the common case, without a call
         return self._judge_report(rep, t_target, tol)
@@ -376,14 +383,19 @@ class RotorTouchdownAdapter(GuardedSlave):
         those the last step validated, and the lane checks h and the clock itself."""
         lane = self._lane
         if lane is not None:
-            if not self._changed:
+            if not self._changed or (self._T_only and self._spin_state):
                 try:
-                    quiet = lane(self._core, current_time, step_size if step_size ==
-                                 self._h_taken else self._host_step(current_time, step_size))
+                    h = (step_size if step_size == self._h_taken
+                         else self._host_step(current_time, step_size))
+                    if self._spin_state:
+                        quiet, report = self._spin_lane_step(lane, current_time, h), \
+                            self._quiet_spin
+                    else:
+                        quiet, report = lane(self._core, current_time, h), self._quiet
                     if quiet is not None:
-                        out, self._quiet.T_imb = quiet
+                        out, report.T_imb = quiet
                         self._publish(self, out, False)
-                        total = sum(out) + self._publish_step_outputs(self._quiet)
+                        total = sum(out) + self._publish_step_outputs(report)
                         if total - total != 0.0:
                             self._refuse_non_finite()
                         return True
@@ -392,6 +404,21 @@ class RotorTouchdownAdapter(GuardedSlave):
                     return False
             self._lane = None
         return GuardedSlave.do_step(self, current_time, step_size)
+
+    def _spin_lane_step(self, lane: Any, t: float, h: float) -> Any:
+        """A step in the spin state's quiet lane (``TouchdownCore.quiet_lane`` with the spin
+        a state) under the drive torque of the step. When T_drive alone was set since the
+        last step (``_T_only``: a drive controller's every step) it is taken here if it
+        lies in its declared range, as ``_check_changes`` would; else None (the guarded
+        step then checks it and says what is wrong)."""
+        if self._changed:
+            T = self.T_drive
+            if not self._T_range[0] <= T <= self._T_range[1]:  # (NaN: not)
+                return None
+            self._step_inputs = (*self._step_inputs[:3], float(T))
+            self._seen_inputs = None  # (the next change re-checks every input)
+            self._changed = self._T_only = False
+        return lane(self._core, t, h, self._step_inputs[3])
 
     def _host_step(self, t: float, step_size: float) -> float:
         """The step to take for the host's step_size at its time t (s): the last one taken

@@ -211,12 +211,15 @@ class FlightSteps:
     """The quiet lane of the state (``quiet_lane``), None when it has none (forgotten with
     the envelope proof)."""
 
-    def quiet_step(self, h: float) -> QuietStep | None:
-        """A step of h seconds under the held inputs of the last step, taken in the quiet
-        lane (``quiet_lane``): ``(output_values(), T_imb)`` at its end; None (nothing done)
-        when the state is not in the lane, and the caller takes ``step``."""
+    def quiet_step(self, h: float, T_drive: float = 0.0) -> QuietStep | None:
+        """A step of h seconds under the held inputs of the last step (and the drive torque
+        T_drive, N m, with the spin a state), taken in the quiet lane (``quiet_lane``):
+        ``(output_values(), T_imb)`` at its end; None (nothing done) when the state is not
+        in the lane, and the caller takes ``step``."""
         lane = self.quiet_lane(h)
-        return None if lane is None else lane(self, self._t, h)
+        if lane is None:
+            return None
+        return lane(self, self._t, h) if self._J == INF else lane(self, self._t, h, T_drive)
 
     def quiet_lane(self, h: float, t_tol: float = 0.0) -> QuietLane | None:
         """The quiet lane for steps of h seconds from times within t_tol (s) of the

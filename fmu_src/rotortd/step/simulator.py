@@ -37,6 +37,7 @@ from ..segments.bearing_contact import ContactState
 from ..segments.dry_whirl_orbit import Orbit, orbit_key
 from ..segments.flight import FlightModel
 from ..segments.rub import RubEquilibrium
+from ..segments.spin_quiet import QuietSpinStep
 from .bearing_step import BearingSteps
 from .contact_step import LOCK_TOL, RUB_RETRY, ContactSteps
 from .flight_step import ETA_HEIGHT, ETA_TIME, N_CASCADE, FlightSteps
@@ -135,6 +136,7 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         self._t_contact = math.nan
         self._slide_step = math.inf
         self._orbit: Orbit | None = None  # rolling with the spin a state: its dry whirl orbit
+        self._quiet_spin: QuietSpinStep | None = None  # the spin state's quiet step (a cache)
         self.imbalance_torque = True
         """Compute the imbalance reaction torque (StepReport.P_imb, T_imb) with the spin
         held. False skips that work (5 to 7 % of the core's instructions in the limit-cycle
@@ -164,7 +166,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
                            ("_advance_contact", "_spin_advance_contact"),
                            ("_advance_spin", "_spin_advance_spin"),
                            ("_roll_or_slide", "_spin_roll_or_slide"),
-                           ("_cone_sign", "_spin_cone_sign"))
+                           ("_cone_sign", "_spin_cone_sign"),
+                           ("quiet_lane", "_spin_quiet_lane"))
     """The choices bound in place of the held spin's when the spin is a state."""
     _BEARING_CHOICES = (("_advance_free", "_bearing_advance_free"),
                         ("_advance_contact", "_bearing_advance_contact"),

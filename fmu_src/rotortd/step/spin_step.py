@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from typing import Any, Protocol
 
 from ..contact.impact import Impact
 from ..contact.search import SEGMENT_WORK, WORK_MAX
@@ -36,7 +37,8 @@ from ..segments.spin_contact import (
     sliding_forces,
 )
 from ..segments.spin_flight import HORIZON, SpinFlight, free_acceleration
-from .flight_step import reference_rate, starts_contact
+from ..segments.spin_quiet import QUIET_WORK, QuietSpinStep
+from .flight_step import QuietStep, reference_rate, starts_contact
 from .report import (
     MODE_FREE,
     MODE_ROLLING,
@@ -83,16 +85,30 @@ class SpinSteps:
 
     def _spin_quiet_step(self, h: float, F: complex, a: float, T_drive: float, cap: int
                          ) -> StepReport | None:
-        """The quiet step: a flight off the wall that ``SpinFlight._run_quiet`` proves clear
-        of it over the whole step with one bound and advances by one short Taylor expansion
-        (docs/model.md 8, "Quiet steps"); the same result, report and work as the step
-        loop's one flight segment that takes that path, without the loop. None when the
-        proof or the expansion does not apply (the step loop then runs)."""
+        """The quiet step: a flight off the wall proved clear of it over the whole step
+        and advanced at once, without the step loop (docs/model.md 8, "Quiet steps"). First
+        the declared accelerator ``QuietSpinStep`` (its own proof, the held-speed closed
+        form plus the spin's collocation; cached for the inputs and h), else
+        ``SpinFlight._run_quiet`` (one bound, one short Taylor expansion): the same result
+        to rounding, with the report and work of the step loop's one flight segment. None
+        when neither applies (the step loop then runs)."""
         W0, p = self._inputs[0], self._p
-        if h * abs(W0) > HORIZON or cap < SEGMENT_WORK or (a == 0.0 and F == 0j):
-            return None  # longer than one bound covers (the horizon is <= HORIZON/|W0|),
-            # or the closed form's flight (bearing off, no external force)
-        fl = SpinFlight(p, self._J, a, F, T_drive, self._z, self._v, self._psi, W0)
+        if cap < SEGMENT_WORK + QUIET_WORK or (a == 0.0 and F == 0j):
+            return None  # (no budget, or the closed form's flight: bearing off, no F_ext)
+        q = self._quiet_spin
+        if q is None or not q.matches(p, self._J, a, F, h):
+            q = self._quiet_spin = QuietSpinStep(p, self._J, a, F, h)
+        z, v = self._z, self._v
+        if q.usable and q.clear(z, v, W0, T_drive):
+            end = q.step(z, v, self._psi, W0, T_drive)
+            if end is not None:
+                self._z, self._v = end[0], end[1]
+                self._set_psi(end[2])
+                self._set_spin(end[3])
+                return self._quiet_report(h, W0, T_drive, cap, QUIET_WORK)
+        if h * abs(W0) > HORIZON:
+            return None  # longer than one bound covers (the horizon is <= HORIZON/|W0|)
+        fl = SpinFlight(p, self._J, a, F, T_drive, z, v, self._psi, W0)
         # (positional: built every quiet step, and keywords cost 0.85 us a call)
         if fl.closed or h > fl.horizon:
             return None
@@ -101,13 +117,37 @@ class SpinSteps:
             return None
         self._z, self._v = end.z, end.v
         self._spin_advance_spin(end)
+        return self._quiet_report(h, W0, T_drive, cap, end.work)
+
+    def _quiet_report(self, h: float, W0: float, T_drive: float, cap: int, work: int
+                      ) -> StepReport:
+        """The report of a quiet step that took ``work`` units, the clock advanced by h."""
         rep = StepReport()
         rep.work_cap = cap
-        rep.work = SEGMENT_WORK + end.work
-        t0 = self._t
-        self._finish(rep, t0, h, h, True)
+        rep.work = SEGMENT_WORK + work
+        self._finish(rep, self._t, h, h, True)
         self._spin_imbalance_torque(rep, W0, T_drive, h)
         return rep
+
+    def _spin_quiet_lane(self, h: float, t_tol: float = 0.0) -> SpinQuietLane | None:
+        """``quiet_lane`` with the spin a state (bound in its place by ``_bind_rotor``): the
+        lane of the quiet step's first branch (``QuietSpinStep``) for steps of h seconds
+        from times within t_tol (s) of the core's; None when the state is not in it
+        (contact, a real bearing, no usable QuietSpinStep for the inputs and h: it exists
+        after a quiet step of h). ``lane(core, t, h, T_drive)`` (``make_spin_quiet_lane``)
+        takes that step under the drive torque T_drive (N m, the other inputs those of the
+        last step) and returns ``(output_values(), T_imb)``; or None, doing nothing, when
+        the step is not proved clear or the core has left the lane."""
+        lane = self._lane
+        if lane is not None and lane.h == h and lane.t_tol == t_tol:
+            return lane
+        _W, F, a = self._inputs
+        q = self._quiet_spin
+        if (self._mode != MODE_FREE or self._on_wall or self._race is not None or q is None
+                or not q.usable or not q.matches(self._p, self._J, a, F, h)):
+            return None
+        self._lane = lane = make_spin_quiet_lane(q, t_tol)
+        return lane
 
     def _spin_imbalance_torque(self, rep: StepReport, W0: float, T_drive: float,
                           span: float) -> None:
@@ -283,3 +323,54 @@ class SpinSteps:
     def _spin_cone_sign(self, st: StepContext) -> float:
         """The slip sign when rolling leaves the friction cone (spin-state forces)."""
         return 1.0 if self._spin_contact_forces(st.held, 0.0).F_t > 0.0 else -1.0
+
+
+class SpinQuietLane(Protocol):
+    """``lane(core, t, h, T_drive)``: one quiet step of h s from t (s) under the drive
+    torque T_drive (N m) (``SpinSteps._spin_quiet_lane``)."""
+
+    h: float
+    t_tol: float
+
+    def __call__(self, core: Any, t: float, h: float, T_drive: float
+                 ) -> QuietStep | None: ...
+
+
+def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
+    """The spin state's quiet lane for the inputs and step of ``q``, from times within
+    t_tol (s) of the core's: ``lane(core, t, h, T_drive)`` takes ``_spin_quiet_step``'s
+    first branch (``q.clear``, ``q.step``) and the step's end as ``_quiet_report`` does
+    (``_set_psi``, the spin, the compensated clock of ``_finish``, T_imb of
+    ``_spin_imbalance_torque`` with P_t = 0), then ``output_values()``: the same
+    operations in the same order, so the same state and values to the bit
+    (tests/test_spin_quiet.py), without the step report and its checks. None, doing
+    nothing, for another h, a clock off the core's, a core that left the lane (other
+    inputs, parameters or J, contact), or a step ``q`` does not prove clear or take."""
+    h, p, J, a, F = q.h, q.p, q.J, q.a, q.F_ext
+    clear, advance, R0 = q.clear, q.step, p.R * 0.0
+
+    def lane(core: Any, t_start: float, h_: float, T: float) -> QuietStep | None:
+        t0 = core._t
+        W0, F_, a_ = core._inputs
+        if (core._lane is not lane or h_ != h or not abs(t_start - t0) <= t_tol
+                or core._mode or core._on_wall or F_ != F or a_ != a or core._p is not p
+                or core._J != J):
+            return None
+        z, v = core._z, core._v
+        if not clear(z, v, W0, T):
+            return None
+        end = advance(z, v, core._psi, W0, T)
+        if end is None:
+            return None
+        core._z, core._v = end[0], end[1]
+        core._set_psi(end[2])
+        Om = end[3]
+        core._inputs = (Om, F_, a_)
+        y = h - core._t_lo
+        t = t0 + y
+        core._t_lo = (t - t0) - y
+        core._t = t
+        return core.output_values(), (J * (Om - W0) - T * h + R0) / h
+
+    lane.h, lane.t_tol = h, t_tol  # type: ignore[attr-defined]
+    return lane  # type: ignore[return-value]
