@@ -7,7 +7,9 @@ variables, validates parameters and inputs, hands each communication step to
 ``TouchdownCore.step`` and publishes the step report (what happened over the step) and
 ``TouchdownCore.output_values`` (what the state shows at its end). While the state is in the
 core's quiet lane (``TouchdownCore.quiet_lane``: a levitated whirl proved clear at held
-inputs), ``do_step`` takes the step in it with one call (docs/architecture.md, frame 0).
+inputs; with the spin a state, the quiet step proved clear step by step, under a drive
+torque that may change every step), ``do_step`` takes the step in it with one call
+(docs/architecture.md, frame 0).
 
 Rules this file follows (see the project's FMI notes):
 - ``__init__`` is cheap and free of side effects (the builder instantiates the class).
@@ -376,11 +378,13 @@ class RotorTouchdownAdapter(GuardedSlave):
     def do_step(self, current_time: float, step_size: float) -> bool:
         """A step in the core's quiet lane (``TouchdownCore.quiet_lane``) while it is held,
         else the guarded step (``GuardedSlave.do_step`` -> ``_step``). The lane is held
-        after a completed step whose state it takes, and dropped by any FMI setter
-        (``_changed``), a failure or terminate (``_fail``, ``terminate``) and by a step it
-        declines (another step size, a host clock off the model time, the core changed);
-        so a lane step needs none of ``_step``'s checks: its inputs and parameters are
-        those the last step validated, and the lane checks h and the clock itself."""
+        after a completed step without events whose state it takes, and dropped by any FMI
+        setter (``_changed``; with the spin a state, a setter of T_drive alone is taken by
+        the lane: ``_spin_lane_step``), a failure or terminate (``_fail``, ``terminate``)
+        and by a step it declines (another step size, a host clock off the model time, the
+        core changed, a step not proved clear); so a lane step needs none of ``_step``'s
+        checks: its inputs and parameters are those the last step validated, and the lane
+        checks h and the clock itself."""
         lane = self._lane
         if lane is not None:
             if not self._changed or (self._T_only and self._spin_state):

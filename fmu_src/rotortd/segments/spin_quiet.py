@@ -65,7 +65,6 @@ step's rate scale |Omega0| + the modes' rate (eps/16)."""
 CLEAR_MARGIN = 32.0 * 2.220446049250313e-16
 """The proof's margin below c_r (relative): the contact resolution (|z| within about 8 eps
 of c_r is at the wall) and the step's point error, as the general search's first bound."""
-TINY = 5e-324
 PASSES = 4
 QUIET_WORK = 8
 """Work units of one quiet step (its fixed cost, about 20 us; the step loop's flight
@@ -158,8 +157,9 @@ class QuietSpinStep:
             return
         F0 = a * p.bias_force + F_ext
         Q = F0 - 1j * m * p.g
-        self._proof = (p.c_r * (1.0 - CLEAR_MARGIN), p.c_r, abs(F0), abs(Q) / m, cA, kA, m,
-                       e_c, J, h)
+        kcr = kA * p.c_r
+        self._proof = (p.c_r * (1.0 - CLEAR_MARGIN), abs(F0) + kcr, (abs(Q) + kcr) / m, cA,
+                       cA / m, e_c, 1.0 / J, h, 2.0 * h, 0.5 * h * h)
         n = 40
         sa, sb = _series(m, cA, kA, 1.0, 0.0, n), _series(m, cA, kA, 0.0, 1.0, n)
         ends = (_poly(sa, h), _poly(sb, h), _poly(sa, h, 1), _poly(sb, h, 1))
@@ -179,7 +179,7 @@ class QuietSpinStep:
             *a2, *b2, *GE, *GEp, *(x for row in Mpp for x in row),
             *(x for row in hA for x in row), *(x for row in h2A2 for x in row),
             *(h * b for b in B), *(h * h * b for b in BD),
-            0.5 * h, (C[2] - C[1]) * h, h * h * h * m * e_c / J,
+            0.5 * h, (C[2] - C[1]) * h, h * h * h * m * e_c / J, h, self.rate, WH_MAX / h,
         )
 
     def matches(self, p: RotorParams, J: float, a: float, F_ext: complex, h: float) -> bool:
@@ -193,16 +193,16 @@ class QuietSpinStep:
         a-priori bound V, W, D of |v|, |Omega|, |Omega'| on the step (twice the increments
         of one sweep, then checked), A of |z''| from it, and |z(t)| <= max(|z0|,
         |z0 + v0 h|) + A h^2/2 (|z0 + v0 t| is convex in t)."""
-        r_in, cr, F0a, qm, cA, kA, m, ec, J, h = self._proof
+        r_in, F0k, qk, cA, cAm, ec, iJ, h, h2, hh = self._proof
         V0, W0, Ta = abs(v0), abs(Om0), abs(T)
-        D = (Ta + ec * (F0a + cA * V0 + kA * cr)) / J
-        A = qm + (cA * V0 + kA * cr) / m + ec * (W0 * W0 + D)
-        V, W = V0 + 2.0 * h * A + TINY, W0 + 2.0 * h * D + TINY
-        D = (Ta + ec * (F0a + cA * V + kA * cr)) / J
-        A = qm + (cA * V + kA * cr) / m + ec * (W * W + D)
+        D = (Ta + ec * (F0k + cA * V0)) * iJ
+        A = qk + cAm * V0 + ec * (W0 * W0 + D)  # (> 0: kA > 0)
+        V, W = V0 + h2 * A, W0 + h2 * D
+        D = (Ta + ec * (F0k + cA * V)) * iJ
+        A = qk + cAm * V + ec * (W * W + D)
         if V0 + h * A > V or W0 + h * D > W:
             return False
-        return max(abs(z0), abs(z0 + h * v0)) + 0.5 * h * h * A <= r_in
+        return max(abs(z0), abs(z0 + h * v0)) + hh * A <= r_in
 
     def step(self, z0: complex, v0: complex, psi0: float, Om0: float, T: float
              ) -> tuple[complex, complex, float, float] | None:
@@ -213,8 +213,9 @@ class QuietSpinStep:
          M11, M12, M13, M21, M22, M23, M31, M32, M33,
          A11, A12, A13, A21, A22, A23, A31, A32, A33,
          D11, D12, D13, D21, D22, D23, D31, D32, D33,
-         B1, B2, B3, BD1, BD2, BD3, h_half, h_d, lip_h) = self._k
-        if (abs(Om0) + self.rate) * self.h > WH_MAX:
+         B1, B2, B3, BD1, BD2, BD3, h_half, h_d, lip_h, h, rate, W_lim) = self._k
+        Wt = abs(Om0) + rate
+        if Wt > W_lim:  # (W h > WH_MAX)
             return None
         E0 = cmath.exp(1j * (psi0 + phi))
         iW = 1j * Om0
@@ -240,7 +241,7 @@ class QuietSpinStep:
         t1, t2, t3 = TJ + mJ * X1.imag, TJ + mJ * X2.imag, TJ + mJ * X3.imag
         ecE1, ecE2, ecE3 = ec * E1, ec * E2, ec * E3
         lip = lip_h * max(abs(X1), abs(X2), abs(X3))
-        tol = TOL_OMEGA * (abs(Om0) + self.rate)
+        tol = TOL_OMEGA * Wt
         p1 = p2 = p3 = 0.0
         for k in range(PASSES + 1):
             # delta and Delta at the nodes (collocation), e^{i delta}, and the forcing f
@@ -280,7 +281,7 @@ class QuietSpinStep:
         wG = iW * PE + fap * u0 + fbp * u1 + (Gp1 * f1 + Gp2 * f2 + Gp3 * f3)
         dd = delta * delta
         ecE = ec * Eh * complex(1.0 - 0.5 * dd, delta - delta * dd / 6.0)
-        return zG - ecE, wG - 1j * Om * ecE, psi0 + (Om0 * self.h + delta), Om
+        return zG - ecE, wG - 1j * Om * ecE, psi0 + (Om0 * h + delta), Om
 
 
 def _green(sb: list[float], h: float, m: float, c: float) -> tuple[list[float], list[float]]:

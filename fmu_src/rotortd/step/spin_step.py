@@ -28,6 +28,7 @@ from ..contact.impact import Impact
 from ..contact.search import SEGMENT_WORK, WORK_MAX
 from ..contact.wall import SegmentEnd, WallForces
 from ..params import InputError, check_finite
+from ..scaled import TWO_PI_HI, TWO_PI_LO
 from ..segments.spin_contact import (
     ContactForces,
     ContactModel,
@@ -341,13 +342,17 @@ def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
     t_tol (s) of the core's: ``lane(core, t, h, T_drive)`` takes ``_spin_quiet_step``'s
     first branch (``q.clear``, ``q.step``) and the step's end as ``_quiet_report`` does
     (``_set_psi``, the spin, the compensated clock of ``_finish``, T_imb of
-    ``_spin_imbalance_torque`` with P_t = 0), then ``output_values()``: the same
-    operations in the same order, so the same state and values to the bit
-    (tests/test_spin_quiet.py), without the step report and its checks. None, doing
-    nothing, for another h, a clock off the core's, a core that left the lane (other
-    inputs, parameters or J, contact), or a step ``q`` does not prove clear or take."""
+    ``_spin_imbalance_torque`` with P_t = 0), then ``output_values()`` in flight, inlined
+    as the held lane inlines them (``flight_step.make_quiet_lane``): the same operations
+    in the same order, so the same state and values to the bit (tests/test_spin_quiet.py),
+    without the step report and its checks. None, doing nothing, for another h, a clock
+    off the core's, a core that left the lane (other inputs, parameters or J, contact),
+    or a step ``q`` does not prove clear or take."""
     h, p, J, a, F = q.h, q.p, q.J, q.a, q.F_ext
     clear, advance, R0 = q.clear, q.step, p.R * 0.0
+    c_r, R, bias = p.c_r, p.R, p.bias_force
+    c, k, a_c = complex(p.c), complex(p.k), complex(a)  # (the bits of the float products)
+    exp, floor, pi, neg_pi = cmath.exp, math.floor, math.pi, -math.pi
 
     def lane(core: Any, t_start: float, h_: float, T: float) -> QuietStep | None:
         t0 = core._t
@@ -356,21 +361,44 @@ def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
                 or core._mode or core._on_wall or F_ != F or a_ != a or core._p is not p
                 or core._J != J):
             return None
-        z, v = core._z, core._v
+        z, v, psi = core._z, core._v, core._psi
         if not clear(z, v, W0, T):
             return None
-        end = advance(z, v, core._psi, W0, T)
+        end = advance(z, v, psi, W0, T)
         if end is None:
             return None
-        core._z, core._v = end[0], end[1]
-        core._set_psi(end[2])
-        Om = end[3]
-        core._inputs = (Om, F_, a_)
+        z, v, psi1, W = end
+        x = psi + (psi1 - psi)  # (_set_psi, _add_psi)
+        q_ = x + pi
+        if not 0.0 <= q_ < TWO_PI_HI:  # (floor(q_ / TWO_PI_HI) != 0: see make_quiet_lane)
+            n = floor(q_ / TWO_PI_HI)
+            x = (x - n * TWO_PI_HI) - n * TWO_PI_LO
+            core._turns += n
+        core._psi = x
+        core._z, core._v = z, v
+        core._inputs = (W, F_, a_)
         y = h - core._t_lo
         t = t0 + y
         core._t_lo = (t - t0) - y
         core._t = t
-        return core.output_values(), (J * (Om - W0) - T * h + R0) / h
+        core._E_at = E = exp(1j * x)  # (_phasor)
+        core._E_of = x
+        rot = E.conjugate()
+        U = z * rot
+        den = c_r * W
+        dU = (v - 1j * W * z) * rot / den if den != 0.0 else 0j
+        if dU - dU != 0j:
+            dU = 0j
+        r = abs(z)
+        rr = r * r
+        x_, y_, vx, vy = z.real, z.imag, v.real, v.imag
+        cross = x_ * vy - y_ * vx
+        whirl = cross / rr if rr > 0.0 else (cross / r) / r if r > 0.0 else 0.0
+        Fa = a_c * (bias - c * v - k * z)
+        return (x_, y_, vx, vy, r / c_r, U.real / c_r, U.imag / c_r, dU.real, dU.imag,
+                -x if x == neg_pi else x, whirl, R * W + c_r * whirl, Fa.real, Fa.imag, W,
+                0, core._n_impacts, core._t_last, core._v_last, core._E_diss
+                ), (J * (W - W0) - T * h + R0) / h
 
     lane.h, lane.t_tol = h, t_tol  # type: ignore[attr-defined]
     return lane  # type: ignore[return-value]
