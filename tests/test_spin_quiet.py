@@ -12,13 +12,12 @@ import random
 
 import mpmath as mp
 import pytest
-from test_spin_flight import MpTaylor, Scene
-
 from rotortd import RotorParams, SpinCore
 from rotortd.segments.spin_flight import SpinFlight
 from rotortd.segments.spin_quiet import WH_MAX, QuietSpinStep
 from rotortd_fmi import touchdown_variables as tv
 from RotorTouchdown import RotorTouchdown
+from test_spin_flight import MpTaylor, Scene
 
 P = RotorParams(g=9.81)
 J0 = 0.5 * P.m * P.R ** 2
@@ -51,12 +50,13 @@ def errors(fl: SpinFlight, sc: Scene, got: tuple[complex, complex, float, float]
             abs(got[2] - psi) / max(1.0, abs(psi)), abs(got[3] - Om) / max(abs(sc.Om), w)]
 
 
-@pytest.mark.parametrize(("h", "W_max"), [(3e-5, 900.0), (1e-4, 900.0), (3e-4, 250.0)])
+@pytest.mark.parametrize(("h", "W_max"), [(3e-5, 900.0), (1e-4, 1800.0), (3e-4, 300.0)])
 def test_equals_short_taylor_at_random_states(h: float, W_max: float) -> None:
     """Against the one definition at 400 random flights per step length, |Omega0| up to
     W_max: within 2e-15 of the scales (measured: at most 1.0e-15, the rounding of both).
-    W h up to WH_MAX (the steps beyond it decline: they are counted, and must be fewer
-    than the compared)."""
+    The step declines where W h > WH_MAX or its truncation estimate is too large (violent
+    drive torques and transients of the light rotor, which the ranges include); at least
+    100 are compared."""
     rng = random.Random(7)
     worst, compared, declined = [0.0] * 4, 0, 0
     for _ in range(400):
@@ -73,14 +73,15 @@ def test_equals_short_taylor_at_random_states(h: float, W_max: float) -> None:
         e = errors(fl, sc, got, (z, v, sc.psi + dpsi, Om))
         worst = [max(x, y) for x, y in zip(worst, e)]
         compared += 1
-    assert compared > 100 and compared > declined, (compared, declined)
+    assert compared >= 100, (compared, declined)
     assert max(worst) <= 2e-15, worst
 
 
 def test_equals_the_40_digit_reference() -> None:
-    """Eight random flights at 1e-4 s, two of them with a drive torque of 40 N m on J/10
-    (|Omega'| ~ 1e4 rad/s^2: the second-order torque takes more than one pass): the end
-    state against MpTaylor (40 digits) within 1e-15 of the scales (psi: its rounding)."""
+    """Eight random flights at 1e-4 s, two of them at 300 rad/s with a drive torque of
+    2 N m on J/10 (Omega' ~ 500 rad/s^2: the second-order torque takes more than one
+    pass): the end state against MpTaylor (40 digits) within 1e-15 of the scales (psi:
+    its rounding)."""
     rng = random.Random(11)
     cases = []
     while len(cases) < 8:
@@ -88,8 +89,8 @@ def test_equals_the_40_digit_reference() -> None:
         if case is not None and case[2].usable:
             sc, fl, q = case
             if len(cases) < 2:
-                sc = Scene(P, J0 / 10, sc.a, sc.F_ext, 40.0 * (-1) ** len(cases), sc.z,
-                           sc.v, sc.psi, sc.Om)
+                sc = Scene(P, J0 / 10, sc.a, sc.F_ext, 2.0 * (-1) ** len(cases), sc.z,
+                           sc.v, sc.psi, 300.0)
                 fl, q = sc.flight(), QuietSpinStep(P, J0 / 10, sc.a, sc.F_ext, 1e-4)
             cases.append((sc, fl, q))
     for sc, fl, q in cases:
@@ -118,8 +119,9 @@ def test_clear_is_sound() -> None:
 
 
 def test_declines() -> None:
-    """Bearing off (no modes to freeze), a step too long for the modes, and a spin whose
-    W h exceeds WH_MAX: the step is not usable or returns None."""
+    """Bearing off (no modes to freeze), a step too long for the modes, a spin whose W h
+    exceeds WH_MAX, a correction too large for the order (the truncation estimate): the
+    step is not usable or returns None."""
     assert not QuietSpinStep(P, J0, 0.0, 0j, 1e-4).usable
     assert not QuietSpinStep(P, J0, 1.0, 0j, 1e-2).usable
     q = QuietSpinStep(P, J0, 1.0, 0j, 1e-4)
@@ -127,6 +129,11 @@ def test_declines() -> None:
     W = WH_MAX / 1e-4 + 1.0
     assert q.step(0j, 0j, 0.0, W, 0.0) is None
     assert q.step(0j, 0j, 0.0, 0.5 * W, 0.0) is not None
+    # a violent spin-up (Omega' = 1e4 rad/s^2 at 1500 rad/s): the truncation estimate
+    # declines it (|delta| at the end, 5e-5 rad, is within DELTA_MAX)
+    q = QuietSpinStep(P, J0 / 10, 1.0, 0j, 1e-4)
+    assert q.step(1e-4 + 0j, 0j, 0.0, 1500.0, 40.0) is None
+    assert q.step(1e-4 + 0j, 0j, 0.0, 500.0, 0.4) is not None
 
 
 def test_core_takes_it_on_the_levitated_whirl() -> None:
@@ -186,7 +193,7 @@ def test_the_lane_is_the_quiet_step_and_output_values_to_the_bit() -> None:
 def test_the_lane_declines_and_leaves_the_core_untouched(leave: str) -> None:
     """Another step length, a clock off the core's time, other inputs (a step with F_ext),
     or a state set: the lane returns None and the core is as it was."""
-    a, b = _twins(184.2, random.Random(1))
+    _a, b = _twins(184.2, random.Random(1))
     lane = b.quiet_lane(1e-4, 1e-6)
     assert lane is not None
     h, t = 1e-4, b.t

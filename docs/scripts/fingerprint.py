@@ -21,8 +21,9 @@ communication step, is recorded to the last bit:
 - the job's tag: the segment kinds it passed through, with counts (TAGS: P proved-free
   flight, F searched flight, S sliding, R rolling, L/Q/K the linear, quadratic and locked
   rub; with the spin as a state C closed-form flight, I integrated flight, q the quiet
-  step (integrated, proved clear at once), s sliding, r rolling), and a summary: impacts, contact time (from the transitions' times), the
-  largest r/c_r at the steps' ends, the steps ending in each mode, nonzero statuses.
+  step (integrated, proved clear at once), s sliding, r rolling), and a summary: impacts,
+  contact time (from the transitions' times), the largest r/c_r at the steps' ends, the
+  steps ending in each mode, nonzero statuses.
 
 The FMU (built from each tree with its own build.py) runs a few scenes through FMPy's
 ``FMU2Slave`` (a spin_* scene with integrate_spin = true); per step every output is read, at
