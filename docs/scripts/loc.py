@@ -50,7 +50,9 @@ GROUPS: dict[str, tuple[str, ...]] = {
         "step/flight_step.py::quiet_step", "step/flight_step.py::quiet_lane",
         "step/flight_step.py::QuietLane", "step/flight_step.py::make_quiet_lane",
         "segments/spin_flight.py::_run_quiet", "segments/spin_flight.py::short_taylor",
-        "step/spin_step.py::_spin_quiet_step"),
+        "step/spin_step.py::_spin_quiet_step", "segments/spin_quiet.py",
+        "step/spin_step.py::_spin_quiet_lane", "step/spin_step.py::SpinQuietLane",
+        "step/spin_step.py::make_spin_quiet_lane", "step/spin_step.py::_quiet_report"),
     "the held spin's declared accelerators (docs/architecture.md)": (
         "segments/flight.py", "segments/rolling.py", "segments/rub.py",
         "segments/sliding.py", "contact/search.py", "contact/impact.py"),
