@@ -115,7 +115,7 @@ def test_the_lane_declines_and_leaves_the_core_untouched(leave: str) -> None:
     assert core.get_state() == before
 
 
-def test_no_lane_in_contact_or_with_the_spin_a_state() -> None:
+def test_no_lane_in_contact_or_with_the_spin_a_state_too_fast() -> None:
     p = RotorParams(m=50.0, c=2763.0, k=9.8e5, e_c=3e-4, phi=0.21, c_r=7e-4, R=0.04,
                     mu=0.15, d=0.95)
     core = TouchdownCore(p, z0=6.9e-4 + 0j, v0=0.05 + 0j, Omega0=184.2)
@@ -125,9 +125,9 @@ def test_no_lane_in_contact_or_with_the_spin_a_state() -> None:
         n += len(rep.impacts)
         assert core.quiet_lane(1e-3) is None or core.mode == 0
     assert n > 0
-    spin = SpinCore.on_steady_whirl(p, 184.2, J=0.04)
+    spin = SpinCore.on_steady_whirl(p, 184.2, J=0.04)  # (its own lane: test_spin_quiet.py)
     for _ in range(3):
-        spin.step(1e-3)
+        spin.step(1e-3)  # W h = 0.32 at 1e-3 s: beyond the spin's quiet step (WH_MAX)
     assert spin.quiet_lane(1e-3) is None and spin.quiet_step(1e-3) is None
 
 

@@ -50,14 +50,15 @@ def errors(fl: SpinFlight, sc: Scene, got: tuple[complex, complex, float, float]
             abs(got[2] - psi) / max(1.0, abs(psi)), abs(got[3] - Om) / max(abs(sc.Om), w)]
 
 
-@pytest.mark.parametrize(("h", "W_max"), [(3e-5, 900.0), (1e-4, 1800.0), (3e-4, 300.0)])
+@pytest.mark.parametrize(("h", "W_max"), [(3e-5, 900.0), (1e-4, 1800.0), (3e-4, 500.0)])
 def test_equals_short_taylor_at_random_states(h: float, W_max: float) -> None:
     """Against the one definition at 400 random flights per step length, |Omega0| up to
     W_max: within 2e-15 of the scales (measured: at most 1.0e-15, the rounding of both).
     The step declines where W h > WH_MAX or its truncation estimate is too large (violent
     drive torques and transients of the light rotor, which the ranges include); at least
     100 are compared."""
-    rng = random.Random(7)
+    rng = random.Random(30)  # (a sample where the estimate at W h instead of 2 W h
+    # would let through steps 2.8e-15 off: docs/scripts/mutants.py Q4)
     worst, compared, declined = [0.0] * 4, 0, 0
     for _ in range(400):
         case = random_flight(rng, h, W_max=W_max)

@@ -255,6 +255,22 @@ MUTANTS: tuple[Mutant, ...] = (
     M("B7", "real bearing: events", "the midpoint check of the contact's event functions "
       "removed", "if self._margin(self._hermite(y, f0, y1, f1, Hs, 0.5)) <= 0.0:",
       "if False:", ("tests/test_real_bearing_core.py",)),
+    # ---------------------------------------------------------------- spin quiet step (#26)
+    M("Q1", "spin quiet step", "the clearance proof without the acceleration term",
+      "return max(abs(z0), abs(z0 + h * v0)) + hh * A <= r_in",
+      "return max(abs(z0), abs(z0 + h * v0)) <= r_in", ("tests/test_spin_quiet.py",)),
+    M("Q2", "spin quiet step", "the second-order torque without e^{i delta}'s real part",
+      "t1 = TJ + mJ * (y1.imag * r1 + y1.real * d1)", "t1 = TJ + mJ * y1.imag",
+      ("tests/test_spin_quiet.py",)),
+    M("Q3", "spin quiet step", "y'' at the nodes without the spring's share (kA y)",
+      "Mpp.append([((1.0 if i == j else 0.0) - cA * GNp[j] - kA * GN[j]) / m",
+      "Mpp.append([((1.0 if i == j else 0.0) - cA * GNp[j]) / m",
+      ("tests/test_spin_quiet.py",)),
+    M("Q4", "spin quiet step", "the truncation estimate at W h instead of 2 W h",
+      "w6 = 2.0 * Wt * h", "w6 = Wt * h", ("tests/test_spin_quiet.py",)),
+    M("Q5", "spin quiet lane", "the lane's T_imb without the drive torque's impulse",
+      "), (J * (W - W0) - T * h + R0) / h", "), (J * (W - W0) + R0) / h",
+      ("tests/test_spin_quiet.py",)),
 )
 
 

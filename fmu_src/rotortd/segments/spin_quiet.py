@@ -204,6 +204,11 @@ class QuietSpinStep:
         return (self.h == h and self.a == a and self.F_ext == F_ext and self.p is p
                 and self.J == J)
 
+    def covers(self, Om0: float) -> bool:
+        """Whether a step from the spin speed Omega0 (rad/s) is within WH_MAX: W h <= WH_MAX,
+        W = |Omega0| + the modes' rate bound (``step`` declines otherwise)."""
+        return (abs(Om0) + self.rate) * self.h <= WH_MAX
+
     def clear(self, z0: complex, v0: complex, Om0: float, T: float) -> bool:
         """Whether the flight from (z0, v0, Omega0) under the drive torque T stays inside
         the clearance circle over the whole step, |z| <= c_r (1 - CLEAR_MARGIN): an

@@ -100,7 +100,7 @@ class SpinSteps:
         if q is None or not q.matches(p, self._J, a, F, h):
             q = self._quiet_spin = QuietSpinStep(p, self._J, a, F, h)
         z, v = self._z, self._v
-        if q.usable and q.clear(z, v, W0, T_drive):
+        if q.usable and q.covers(W0) and q.clear(z, v, W0, T_drive):
             end = q.step(z, v, self._psi, W0, T_drive)
             if end is not None:
                 self._z, self._v = end[0], end[1]
@@ -135,17 +135,19 @@ class SpinSteps:
         lane of the quiet step's first branch (``QuietSpinStep``) for steps of h seconds
         from times within t_tol (s) of the core's; None when the state is not in it
         (contact, a real bearing, no usable QuietSpinStep for the inputs and h: it exists
-        after a quiet step of h). ``lane(core, t, h, T_drive)`` (``make_spin_quiet_lane``)
-        takes that step under the drive torque T_drive (N m, the other inputs those of the
-        last step) and returns ``(output_values(), T_imb)``; or None, doing nothing, when
-        the step is not proved clear or the core has left the lane."""
+        after a quiet step of h; a spin too fast for it, ``QuietSpinStep.covers``).
+        ``lane(core, t, h, T_drive)`` (``make_spin_quiet_lane``) takes that step under the
+        drive torque T_drive (N m, the other inputs those of the last step) and returns
+        ``(output_values(), T_imb)``; or None, doing nothing, when the step is not proved
+        clear or the core has left the lane."""
         lane = self._lane
         if lane is not None and lane.h == h and lane.t_tol == t_tol:
             return lane
         _W, F, a = self._inputs
         q = self._quiet_spin
         if (self._mode != MODE_FREE or self._on_wall or self._race is not None or q is None
-                or not q.usable or not q.matches(self._p, self._J, a, F, h)):
+                or not q.usable or not q.matches(self._p, self._J, a, F, h)
+                or not q.covers(_W)):
             return None
         self._lane = lane = make_spin_quiet_lane(q, t_tol)
         return lane
