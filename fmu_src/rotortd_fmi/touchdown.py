@@ -387,19 +387,17 @@ class RotorTouchdownAdapter(GuardedSlave):
         checks h and the clock itself."""
         lane = self._lane
         if lane is not None:
-            if not self._changed or (self._T_only and self._spin_state):
+            if self._spin_state:
+                if not self._changed or self._T_only:
+                    return self._spin_lane_do_step(lane, current_time, step_size)
+            elif not self._changed:
                 try:
-                    h = (step_size if step_size == self._h_taken
-                         else self._host_step(current_time, step_size))
-                    if self._spin_state:
-                        quiet, report = self._spin_lane_step(lane, current_time, h), \
-                            self._quiet_spin
-                    else:
-                        quiet, report = lane(self._core, current_time, h), self._quiet
+                    quiet = lane(self._core, current_time, step_size if step_size ==
+                                 self._h_taken else self._host_step(current_time, step_size))
                     if quiet is not None:
-                        out, report.T_imb = quiet
+                        out, self._quiet.T_imb = quiet
                         self._publish(self, out, False)
-                        total = sum(out) + self._publish_step_outputs(report)
+                        total = sum(out) + self._publish_step_outputs(self._quiet)
                         if total - total != 0.0:
                             self._refuse_non_finite()
                         return True
@@ -407,6 +405,26 @@ class RotorTouchdownAdapter(GuardedSlave):
                     self._step_failed(current_time, step_size, exc)
                     return False
             self._lane = None
+        return GuardedSlave.do_step(self, current_time, step_size)
+
+    def _spin_lane_do_step(self, lane: Any, current_time: float, step_size: float) -> bool:
+        """``do_step`` in the spin state's quiet lane (``_spin_lane_step``), publishing as
+        the held lane does; the guarded step when the lane declines."""
+        try:
+            quiet = self._spin_lane_step(lane, current_time, step_size if step_size ==
+                                         self._h_taken else self._host_step(current_time,
+                                                                            step_size))
+            if quiet is not None:
+                out, self._quiet_spin.T_imb = quiet
+                self._publish(self, out, False)
+                total = sum(out) + self._publish_step_outputs(self._quiet_spin)
+                if total - total != 0.0:
+                    self._refuse_non_finite()
+                return True
+        except Exception as exc:
+            self._step_failed(current_time, step_size, exc)
+            return False
+        self._lane = None
         return GuardedSlave.do_step(self, current_time, step_size)
 
     def _spin_lane_step(self, lane: Any, t: float, h: float) -> Any:
