@@ -380,7 +380,7 @@ class RotorTouchdownAdapter(GuardedSlave):
         else the guarded step (``GuardedSlave.do_step`` -> ``_step``). The lane is held
         after a completed step without events whose state it takes, and dropped by any FMI
         setter (``_changed``; with the spin a state, a setter of T_drive alone is taken by
-        the lane: ``_spin_lane_step``), a failure or terminate (``_fail``, ``terminate``)
+        the lane: ``_spin_lane_do_step``), a failure or terminate (``_fail``, ``terminate``)
         and by a step it declines (another step size, a host clock off the model time, the
         core changed, a step not proved clear); so a lane step needs none of ``_step``'s
         checks: its inputs and parameters are those the last step validated, and the lane
@@ -408,12 +408,23 @@ class RotorTouchdownAdapter(GuardedSlave):
         return GuardedSlave.do_step(self, current_time, step_size)
 
     def _spin_lane_do_step(self, lane: Any, current_time: float, step_size: float) -> bool:
-        """``do_step`` in the spin state's quiet lane (``_spin_lane_step``), publishing as
-        the held lane does; the guarded step when the lane declines."""
+        """``do_step`` in the spin state's quiet lane (``TouchdownCore.quiet_lane`` with the
+        spin a state) under the drive torque of the step, publishing as the held lane does;
+        the guarded step when the lane declines. When T_drive alone was set since the last
+        step (``_T_only``: a drive controller's every step) it is taken here if it lies in
+        its declared range, as ``_check_changes`` would; else the guarded step checks it and
+        says what is wrong."""
         try:
-            quiet = self._spin_lane_step(lane, current_time, step_size if step_size ==
-                                         self._h_taken else self._host_step(current_time,
-                                                                            step_size))
+            if self._changed:
+                T = self.T_drive
+                if not self._T_range[0] <= T <= self._T_range[1]:  # (NaN: not)
+                    self._lane = None
+                    return GuardedSlave.do_step(self, current_time, step_size)
+                self._step_inputs = (*self._step_inputs[:3], float(T))
+                self._seen_inputs = None  # (the next change re-checks every input)
+                self._changed = self._T_only = False
+            quiet = lane(self._core, current_time, step_size if step_size == self._h_taken
+                         else self._host_step(current_time, step_size), self._step_inputs[3])
             if quiet is not None:
                 out, self._quiet_spin.T_imb = quiet
                 self._publish(self, out, False)
@@ -426,21 +437,6 @@ class RotorTouchdownAdapter(GuardedSlave):
             return False
         self._lane = None
         return GuardedSlave.do_step(self, current_time, step_size)
-
-    def _spin_lane_step(self, lane: Any, t: float, h: float) -> Any:
-        """A step in the spin state's quiet lane (``TouchdownCore.quiet_lane`` with the spin
-        a state) under the drive torque of the step. When T_drive alone was set since the
-        last step (``_T_only``: a drive controller's every step) it is taken here if it
-        lies in its declared range, as ``_check_changes`` would; else None (the guarded
-        step then checks it and says what is wrong)."""
-        if self._changed:
-            T = self.T_drive
-            if not self._T_range[0] <= T <= self._T_range[1]:  # (NaN: not)
-                return None
-            self._step_inputs = (*self._step_inputs[:3], float(T))
-            self._seen_inputs = None  # (the next change re-checks every input)
-            self._changed = self._T_only = False
-        return lane(self._core, t, h, self._step_inputs[3])
 
     def _host_step(self, t: float, step_size: float) -> float:
         """The step to take for the host's step_size at its time t (s): the last one taken
