@@ -260,7 +260,7 @@ MUTANTS: tuple[Mutant, ...] = (
       "return max(abs(z0), abs(z0 + h * v0)) + hh * A <= r_in",
       "return max(abs(z0), abs(z0 + h * v0)) <= r_in", ("tests/test_spin_quiet.py",)),
     M("Q2", "spin quiet step", "the second-order torque without e^{i delta}'s real part",
-      "t1 = TJ + mJ * (y1.imag * r1 + y1.real * d1)", "t1 = TJ + mJ * y1.imag",
+      "t1 = TJ + mJ * (y1.imag * (1.0 - s1) + y1.real * d1)", "t1 = TJ + mJ * y1.imag",
       ("tests/test_spin_quiet.py",)),
     M("Q3", "spin quiet step", "y'' at the nodes without the spring's share (kA y)",
       "Mpp.append([((1.0 if i == j else 0.0) - cA * GNp[j] - kA * GN[j]) / m",

@@ -270,16 +270,16 @@ class QuietSpinStep:
             d1 = D11 * t1 + D12 * t2 + D13 * t3
             d2 = D21 * t1 + D22 * t2 + D23 * t3
             d3 = D31 * t1 + D32 * t2 + D33 * t3
-            W1 = Om0 + (A11 * t1 + A12 * t2 + A13 * t3)
-            W2 = Om0 + (A21 * t1 + A22 * t2 + A23 * t3)
-            W3 = Om0 + (A31 * t1 + A32 * t2 + A33 * t3)
-            r1, r2, r3 = 1.0 - 0.5 * d1 * d1, 1.0 - 0.5 * d2 * d2, 1.0 - 0.5 * d3 * d3
-            f1 = ecE1 * complex(-kA * (1.0 - r1) - cA * W1 * d1,
-                                kA * d1 + cA * (W1 * r1 - Om0))
-            f2 = ecE2 * complex(-kA * (1.0 - r2) - cA * W2 * d2,
-                                kA * d2 + cA * (W2 * r2 - Om0))
-            f3 = ecE3 * complex(-kA * (1.0 - r3) - cA * W3 * d3,
-                                kA * d3 + cA * (W3 * r3 - Om0))
+            D1 = A11 * t1 + A12 * t2 + A13 * t3  # Delta at the nodes
+            D2 = A21 * t1 + A22 * t2 + A23 * t3
+            D3 = A31 * t1 + A32 * t2 + A33 * t3
+            W1, W2, W3 = Om0 + D1, Om0 + D2, Om0 + D3
+            s1, s2, s3 = 0.5 * d1 * d1, 0.5 * d2 * d2, 0.5 * d3 * d3  # e^{i d} = 1 - s + i d
+            # f/(e_c E_h) = (kA + i cA W) e^{i delta} - (kA + i cA Omega0)
+            #             = -kA s - cA W delta + i (kA delta + cA (Delta - W s))
+            f1 = ecE1 * complex(-kA * s1 - cA * W1 * d1, kA * d1 + cA * (D1 - W1 * s1))
+            f2 = ecE2 * complex(-kA * s2 - cA * W2 * d2, kA * d2 + cA * (D2 - W2 * s2))
+            f3 = ecE3 * complex(-kA * s3 - cA * W3 * d3, kA * d3 + cA * (D3 - W3 * s3))
             if k and lip * max(abs(t1 - p1), abs(t2 - p2), abs(t3 - p3)) <= tol:
                 break
             if k == PASSES:
@@ -289,9 +289,9 @@ class QuietSpinStep:
             y1 = (M11 * f1 + M12 * f2 + M13 * f3).conjugate() * E1 + X1
             y2 = (M21 * f1 + M22 * f2 + M23 * f3).conjugate() * E2 + X2
             y3 = (M31 * f1 + M32 * f2 + M33 * f3).conjugate() * E3 + X3
-            t1 = TJ + mJ * (y1.imag * r1 + y1.real * d1)
-            t2 = TJ + mJ * (y2.imag * r2 + y2.real * d2)
-            t3 = TJ + mJ * (y3.imag * r3 + y3.real * d3)
+            t1 = TJ + mJ * (y1.imag * (1.0 - s1) + y1.real * d1)
+            t2 = TJ + mJ * (y2.imag * (1.0 - s2) + y2.real * d2)
+            t3 = TJ + mJ * (y3.imag * (1.0 - s3) + y3.real * d3)
         delta = BD1 * t1 + BD2 * t2 + BD3 * t3
         if not abs(delta) <= DELTA_MAX:
             return None
