@@ -46,9 +46,10 @@ transient's oscillating torque on a light rotor). The step declines (None) when 
 criterion), and when W h > WH_MAX (0.2). Where it steps it equals ``short_taylor`` to
 1e-15 of the scales (c_r, c_r w, |Omega|) at random levitated flights (speeds to 1800
 rad/s at 1e-4 s, drive torques to 50 N m on J = 0.004 ... 0.4 kg m^2) and the 40-digit
-reference to 3e-16 (tests/test_spin_quiet.py). On the chapter's levitated whirl (W h =
-0.032 at 1e-4 s) the estimate is below 1e-23 m. The terms left out (third order in delta)
-are below 1e-18 where |delta| <= DELTA_MAX at the step's end (else None).
+reference to 1e-15 (2.5e-16 to 9.8e-16 measured; tests/test_spin_quiet.py). On the
+chapter's levitated whirl (W h = 0.032 at 1e-4 s) the estimate is below 1e-23 m. The terms
+left out (third order in delta) are below 1e-18 where |delta| <= DELTA_MAX at the step's
+end (else None).
 
 Work: a fixed number of operations per step (no loop depends on the data).
 """
