@@ -60,6 +60,7 @@ import cmath
 import math
 
 from ..params import RotorParams
+from .spin_flight import EPS
 
 S = 3
 """Gauss-Legendre nodes of the collocation (the step is written out for three)."""
@@ -71,10 +72,11 @@ DELTA_MAX = 1e-4
 TOL_OMEGA = 2.0 ** -56
 """The fixed point's tolerance: what one more pass would move Omega by, relative to the
 step's rate scale |Omega0| + the modes' rate (eps/16)."""
-CLEAR_MARGIN = 32.0 * 2.220446049250313e-16
+CLEAR_MARGIN = 32.0 * EPS
 """The proof's margin below c_r (relative): the contact resolution (|z| within about 8 eps
 of c_r is at the wall) and the step's point error, as the general search's first bound."""
 PASSES = 4
+"""Passes of the second-order torque the step takes at most (the chapter's rotor: one)."""
 TRUNC_K = 1e-2
 """The truncation estimate of the step's position: TRUNC_K (2 W h)^6 (|y| + h |y'|) (m), y
 the spin's correction of the mass centre. Measured: the error over that measure is 3e-6 to
@@ -86,7 +88,6 @@ TAYLOR_TOL: a truncation below rounding)."""
 QUIET_WORK = 8
 """Work units of one quiet step (its fixed cost, about 20 us; the step loop's flight
 segment charges SEGMENT_WORK besides)."""
-"""Passes of the second-order torque the step takes at most (the chapter's rotor: one)."""
 
 
 def _legendre_nodes(n: int) -> tuple[list[float], list[float]]:
