@@ -78,6 +78,7 @@ V3_LEAVES = {
     "rotor.v.0", "rotor.v.1", "rotor.psi", "rotor.turns", "rotor.Omega", "rotor.J",
     "contact.mode", "contact.theta", "contact.dtheta", "contact.slip", "contact.locked",
     "contact.on_wall", "contact.t_contact", "contact.slide_step", "contact.orbit_energy",
+    "contact.orbit_step",
     "counters.n_impacts",
     "counters.t_last", "counters.v_last", "counters.E_diss", "step.F_ext.0", "step.F_ext.1",
     "step.amb_on", "step.imb_h.0", "step.imb_h.1",
@@ -155,7 +156,7 @@ def _as_version_3(v2: dict) -> dict:
         "bearing": {"kind": "fixed-rigid"},
         "contact": {k: v2[k] for k in ("mode", "theta", "dtheta", "slip", "locked",
                                        "on_wall", "t_contact")}
-                   | {"slide_step": v2["H"], "orbit_energy": None},
+                   | {"slide_step": v2["H"], "orbit_energy": None, "orbit_step": None},
         "counters": {k: v2[k] for k in ("n_impacts", "t_last", "v_last", "E_diss")},
         "step": {"F_ext": inputs[1:3], "amb_on": inputs[3], "imb_h": v2["imb_h"]},
     }

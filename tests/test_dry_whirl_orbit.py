@@ -136,8 +136,9 @@ def test_the_orbit_carries_over_steps_and_states() -> None:
         core.step(H, amb_on=0.0)
         energies.add(core.state.orbit_energy)
     assert core.mode == 2 and len(energies) == 1 and not math.isnan(energies.pop())
+    assert core._orbit.map is not None and core._orbit.map.ok and core._orbit.map.h == H
     doc = json.loads(json.dumps(core.get_state()))
-    assert doc["contact"]["orbit_energy"] is not None
+    assert doc["contact"]["orbit_energy"] is not None and doc["contact"]["orbit_step"] == H
     run = [core.step(H, amb_on=0.0).work for _ in range(10)]
     again = _rolling_core(1.0)
     again.set_state(doc)
@@ -174,3 +175,38 @@ def test_declines_where_it_must() -> None:
     orb = _advance(_held(), TH0, PSI0, W, H)[1]
     assert orb is not None and orb.ok  # below the work a step needs: declined, the orbit kept
     assert orbit_mod.advance(orb, _held(), TH0, PSI0, W, H, 10, math.inf) == (None, orb)
+
+
+def test_the_step_map_agrees_with_newton_within_its_share() -> None:
+    """``StepMap`` (docs/notes/dry-whirl-quadrature.md §9), built by the second step of one
+    length, against ``_solve``'s Newton from random starts on the orbit: u within its share
+    of the tolerance (the smaller of TOL_PHASE in theta and TOL_IMPULSE of u), the periodic
+    impulses within theirs of the mean impulse, plus rounding."""
+    rng = random.Random(5)
+    share = orbit_mod.MAP_SHARE
+    checked = 0
+    for _ in range(40):
+        h, W, th, psi, rem = _random_case(rng)
+        end, orb = _advance(h, th, psi, W, rem)
+        if end is None:
+            continue
+        end, orb = _advance(h, end.theta, end.psi, end.Omega, rem, orb)
+        m = orb.map
+        assert end is not None and m is not None and m.h == rem
+        if not m.ok:
+            continue
+        w = DryWhirl(h, end.theta, end.psi, end.Omega)
+        for _ in range(5):
+            beta, psi_s = rng.uniform(-math.pi, math.pi), rng.uniform(-math.pi, math.pi)
+            g = orbit_mod.on_orbit(orb, w, beta, psi_s)
+            x, P, q = orbit_mod._solve(orb, g, g.theta0, psi_s, rem)
+            xm, Pm, qm = m.at(beta, psi_s)
+            u = rem / orb.f00 + x
+            tol_u = share * min(1e-14 * (1 + w.rho * u) / w.rho, 1e-14 * u)
+            assert abs(xm - x) <= 1.1 * tol_u + 4 * math.ulp(u), (xm, x, tol_u)
+            tol_p = share * 1e-14 * abs(orb.d00) * u
+            assert abs(Pm - P) <= 1.1 * tol_p + 1e-15 * abs(orb.d00) * u, (Pm, P, tol_p)
+            if w.akcr:
+                assert abs(qm - q) * w.akcr <= 1.1 * tol_p + 1e-15 * abs(orb.d00) * u
+            checked += 1
+    assert checked >= 100, checked

@@ -77,8 +77,14 @@ which an orbit is built; at 0.015 the chapter's rotor's series meet the toleranc
 at 0.02 they do not."""
 DELTA_MAX = 0.05
 """Largest 2 m R e_c / (J + m (R^2 + e_c^2)) (I_P's modulation) for which one is built."""
+MAP_SHARE = 0.5
+"""The share of the step's tolerance (TOL_PHASE, TOL_IMPULSE) a ``StepMap``'s left-out terms
+may take (the orbit's own series take the rest, ``_within_tolerance``)."""
 NEWTON_ITERS = 12
 """Most Newton iterations of the step end (it converges in 3 to 5)."""
+MAP_WORK = SAMPLE_WORK * N_BETA * N_PSI * (2 * NEWTON_ITERS + 5)
+"""The most work (units) a ``StepMap`` build takes: a step's Newton at every grid point; it
+is built only where the step's work limit covers this."""
 
 _BG = [2.0 * math.pi * a / N_BETA for a in range(N_BETA)]
 _CB = [math.cos(b) for b in _BG]
@@ -91,6 +97,9 @@ _PSI_ROWS = [[cmath.exp(-1j * jp * 2.0 * math.pi * b / N_PSI) / N_PSI for b in r
 """_PSI_ROWS[l + K_PSI + 1][b] = e^{-i l psi_b}/N_PSI: the DFT rows in psi."""
 
 Key = tuple[Any, ...]
+Row = tuple[int, int, int, list[complex]]
+"""One row of a 2-D series (``_trimmed``): an index into the outer powers, the span into
+the inner powers and the coefficients over it."""
 
 
 def orbit_key(p: RotorParams, J: float, a: float, F_ext: complex, Omega: float) -> Key:
@@ -104,11 +113,16 @@ class Orbit:
     on first use (``build``; an orbit restored from a state is built at its next step)."""
 
     __slots__ = ("A", "B", "C", "E", "built", "d00", "err_d", "err_t", "f00", "kappa",
-                 "key", "n_rows", "n_sec", "ok", "w_max")
+                 "key", "last_rem", "map", "n_rows", "n_sec", "ok", "w_max")
 
-    def __init__(self, E: float, key: Key) -> None:
+    def __init__(self, E: float, key: Key, last_rem: float = math.nan) -> None:
         self.E, self.key = E, key
         self.built = self.ok = False
+        self.map: StepMap | None = None
+        self.last_rem = last_rem
+        """The length (s) of the last segment taken on the orbit (NaN: none): a segment of
+        the same length again builds the orbit's ``StepMap`` (part of the core's state,
+        ``CoreState.orbit_step``, so that a restored state makes the same choice)."""
 
     def build(self, w: DryWhirl) -> None:
         """The coefficients from the grid, with ``w``'s constants (the held inputs of key)."""
@@ -190,6 +204,116 @@ class Orbit:
         return fq, dq
 
 
+class StepMap:
+    """A step of fixed length h (s) on an orbit as functions of its start (beta_s, psi_s) on
+    the torus (docs/notes/dry-whirl-quadrature.md §9): the spin angle travelled,
+    u = h/F_00 + x(beta_s, psi_s) (rad), and the periodic parts of the impulses,
+    P - d00 u (N s) and, when a k != 0, int n dt - n_sec u (s), P = int (N + i F_t) dt.
+    Each is a smooth periodic function of the start (the orbit's integrands are), sampled
+    on the orbit's grid by ``_solve`` (Newton on the orbit's series to the ulp of u, in x
+    and so rounded relative to x) and kept as its 2-D Fourier series: a step of h is then
+    one evaluation of these sums in place of Newton's. Terms are left out, smallest first,
+    while their sum with the check harmonics' (+-(K + 1), twice for the tail and the
+    aliasing) stays within MAP_SHARE of the step's tolerance at the shortest u of the grid:
+    for x the smaller of TOL_PHASE in theta and TOL_IMPULSE of u (u carries the mean
+    impulse d00 u), for the impulses TOL_IMPULSE of the mean impulse |d00| u. ``ok`` is
+    False where the check harmonics alone exceed it, or the orbit's own series exceed the
+    rest of the tolerance (Newton then takes the steps)."""
+
+    __slots__ = ("P", "Q", "U", "h", "ok", "x00")
+
+    def __init__(self, orb: Orbit, w: DryWhirl, h: float) -> None:
+        self.h = h
+        us: list[list[float]] = []
+        ps: list[list[complex]] = []
+        qs: list[list[complex]] = []
+        for a in range(N_BETA):  # (rows over psi at one beta)
+            ru, rp, rq = [], [], []
+            for b in range(N_PSI):
+                psi = 2.0 * math.pi * b / N_PSI
+                g = on_orbit(orb, w, _BG[a], psi)
+                u, P, q = _solve(orb, g, g.theta0, psi, h)
+                ru.append(u)
+                rp.append(P)
+                rq.append(q)
+            us.append(ru)
+            ps.append(rp)
+            qs.append(rq)
+        cu, cp = _dft2(us), _dft2(ps)
+        u_min = h / orb.f00 + min(map(min, us))
+        self.x00 = cu[(0, 0)].real
+        tol_u = MAP_SHARE * min(TOL_PHASE * (1.0 + w.rho * u_min) / w.rho,
+                                TOL_IMPULSE * u_min)  # (u carries the mean impulse d00 u)
+        tol_p = MAP_SHARE * TOL_IMPULSE * abs(orb.d00) * u_min
+        self.U, ok_u = _map_rows(cu, tol_u, True)
+        self.P, ok_p = _map_rows(cp, tol_p, False)
+        self.Q, ok_q = (_map_rows(_dft2(qs), tol_p / w.akcr, False) if w.akcr
+                        else (([], False), True))
+        self.ok = (ok_u and ok_p and ok_q
+                   and _within_tolerance(orb, w, u_min, 1.0 - MAP_SHARE))
+
+    def at(self, beta: float, psi: float) -> tuple[float, complex, complex]:
+        """``_solve``'s (x = u - h/F_00 (rad), P - d00 u (N s), int n dt - n_sec u (s)) of
+        the step of h from (beta, psi) (rad)."""
+        eb = _powers(cmath.exp(1j * beta), K_BETA)
+        ep = _powers(cmath.exp(1j * psi), K_PSI)
+        x = self.x00 + 2.0 * _map_series(self.U, eb, ep).real
+        return (x, _map_series(self.P, eb, ep),
+                _map_series(self.Q, eb, ep) if self.Q[0] else 0j)
+
+
+def on_orbit(orb: Orbit, w: DryWhirl, beta: float, psi: float) -> DryWhirl:
+    """The physics (``w``'s held inputs) of the state at (beta, psi) (rad) on ``orb``: theta
+    = psi + phi - beta, Omega (in w's direction) and K0 from the orbit's energy."""
+    g = DryWhirl(w.h, psi + w.phi - beta, psi, w.sig)
+    g.K0 = 2.0 * (orb.E - (-g.v0 + g.mge * g.sE0))
+    g.Omega0 = w.sig * math.sqrt(g.K0 / (w.I0 - w.c2 * math.cos(beta)))
+    return g
+
+
+MapRows = tuple[list[Row], bool]
+"""A map's series: its rows (``_trimmed``) and whether they run over psi."""
+
+
+def _map_series(rows: MapRows, eb: list[complex], ep: list[complex]) -> complex:
+    """``_series`` of a map's rows (``_map_rows``: over beta, or over psi when flagged)."""
+    return _series(rows[0], ep, eb) if rows[1] else _series(rows[0], eb, ep)
+
+
+def _dft2(x: list[list[Any]]) -> dict[tuple[int, int], complex]:
+    """The 2-D DFT of values x[a][b] on the orbit's grid (beta_a, psi_b): the coefficients
+    c_jl, |j| <= K_BETA + 1, |l| <= K_PSI + 1, of x = sum c_jl e^{i (j beta + l psi)}."""
+    k1, jp1 = K_BETA + 1, K_PSI + 1
+    cols = [[sum(map(mul, col, _BETA_ROWS[j])) for col in zip(*x)]
+            for j in range(-k1, k1 + 1)]  # cols[j + k1][b]: the DFT in beta at psi_b
+    return {(j, jp): sum(map(mul, cols[j + k1], _PSI_ROWS[jp + jp1]))
+            for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)}
+
+
+def _map_rows(c: dict[tuple[int, int], complex], tol: float, real: bool
+              ) -> tuple[MapRows, bool]:
+    """The rows of ``_series`` for the kept part of a map's series c (for a real function
+    the half j > 0 or j = 0 < l, to be doubled and added to c_00), over beta or over psi,
+    whichever takes fewer (``_map_series``), smallest terms left out
+    while the check harmonics' bound (2 sum |c|) plus theirs stays within tol; and whether
+    the check harmonics alone are within it."""
+    k1, jp1 = K_BETA + 1, K_PSI + 1
+    err = 2.0 * sum(abs(v) for (j, jp), v in c.items() if abs(j) == k1 or abs(jp) == jp1)
+    ok = err <= tol
+    kept = {k for k in c if abs(k[0]) < k1 and abs(k[1]) < jp1
+            and (k[0] > 0 or (k[0] == 0 and k[1] > 0) if real else True)}
+    left = set()
+    for k in sorted(kept - {(0, 0)}, key=lambda k: abs(c[k])):
+        cost = abs(c[k]) * (2.0 if real else 1.0)
+        if err + cost > tol:
+            break
+        err += cost
+        left.add(k)
+    rows = [_trimmed(lambda j, jp: c[(j, jp)] if (j, jp) in kept and (j, jp) not in left
+                     else 0j, 0, by_psi) for by_psi in (False, True)]
+    return (rows[0], False) if len(rows[0]) <= len(rows[1]) else (rows[1], True), ok
+
+
 def _small(c: dict[tuple[int, int], complex], scale: float) -> list[tuple[int, int]]:
     """The kept harmonics (|j| <= K_BETA, |l| <= K_PSI, not (0, 0)) of a series c at most
     TRIM scale: left out of the sums (at the rounding level of the grid's DFT, 1e-17 of the
@@ -208,18 +332,20 @@ def _dropped(c: dict[tuple[int, int], complex], left: list[tuple[int, int]], rho
             sum(abs(c[k]) for k in fast), sum(abs(c[k]) for k in left if not k[0]))
 
 
-Row = tuple[int, int, int, list[complex]]
-
-
-def _trimmed(coef: Any, wide: int) -> list[Row]:
+def _trimmed(coef: Any, wide: int, by_psi: bool = False) -> list[Row]:
     """The rows j = -K_BETA-wide .. K_BETA+wide over l = -K_PSI-wide .. K_PSI+wide of
     coef(j, l) (the coefficients of a sum ``_series`` evaluates: the kept harmonics,
     wide = 0; one more each way for int n dt, wide = 1), each cut to the span of its nonzero
     entries: (row index into the beta powers, first and end index into the psi powers, the
-    coefficients); rows without any left out."""
+    coefficients); rows without any left out. ``by_psi``: the rows over l instead, each
+    over j (indices into the psi powers, then the beta powers)."""
+    outer = range(-K_PSI - wide, K_PSI + wide + 1) if by_psi else range(
+        -K_BETA - wide, K_BETA + wide + 1)
+    inner = range(-K_BETA - wide, K_BETA + wide + 1) if by_psi else range(
+        -K_PSI - wide, K_PSI + wide + 1)
     out = []
-    for a, j in enumerate(range(-K_BETA - wide, K_BETA + wide + 1)):
-        row = [coef(j, jp) for jp in range(-K_PSI - wide, K_PSI + wide + 1)]
+    for a, k in enumerate(outer):
+        row = [coef(i, k) if by_psi else coef(k, i) for i in inner]
         nz = [i for i, x in enumerate(row) if x]
         if nz:
             out.append((a, nz[0], nz[-1] + 1, row[nz[0]:nz[-1] + 1]))
@@ -292,49 +418,86 @@ def advance(prev: Orbit | None, h: HeldInputs, theta: float, psi: float, Omega: 
     w.K0 = 2.0 * (orb.E - (-w.v0 + w.mge * w.sE0))  # Omega^2 on the path from the orbit's E
     if not _within_tolerance(orb, w, rem * abs(Omega)):
         return None, orb
-    return _step(orb, w, theta, psi, rem, cost, step0), orb
+    return _step(orb, w, theta, psi, rem, cost, step0, _mapped(orb, w, theta, psi, rem, limit)
+                 or _solve(orb, w, theta, psi, rem)), orb
 
 
-def _within_tolerance(orb: Orbit, w: DryWhirl, du: float) -> bool:
-    """The dropped harmonics' error over a step of du rad of psi within TOL_PHASE (1 + its
-    turn of theta) rad of theta and TOL_IMPULSE of its mean impulse. Each dropped term
-    integrates to at most |c_jl| min(du, 2/|w_jl|) (``_dropped``)."""
+def _mapped(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, limit: int
+            ) -> tuple[float, complex, complex] | None:
+    """The step of rem from the orbit's ``StepMap`` of rem: built when the orbit's last
+    segment had the same length (and the work limit covers MAP_WORK; like a restored
+    orbit's build it is not charged, so that the work counts are the state's alone), kept
+    while the segments keep that length; None where there is none (``_solve`` then)."""
+    m, last = orb.map, orb.last_rem
+    orb.last_rem = rem
+    if m is None or m.h != rem:
+        if last != rem or limit < MAP_WORK:
+            return None
+        m = orb.map = StepMap(orb, w, rem)
+    return m.at(psi + w.phi - theta, psi) if m.ok else None
+
+
+def _within_tolerance(orb: Orbit, w: DryWhirl, du: float, share: float = 1.0) -> bool:
+    """The dropped harmonics' error over a step of du rad of psi within ``share`` of
+    TOL_PHASE (1 + its turn of theta) rad of theta and of TOL_IMPULSE of its mean impulse.
+    Each dropped term integrates to at most |c_jl| min(du, 2/|w_jl|) (``_dropped``)."""
     a, b, c = orb.err_t
     e_t = min(a, b * du) + c * du
     a, b, c = orb.err_d
     e_d = min(a, b * du) + c * du + w.akcr * e_t
-    return (e_t * w.rho * orb.w_max <= TOL_PHASE * (1.0 + w.rho * du)
-            and e_d <= TOL_IMPULSE * abs(orb.d00) * du)
+    return (e_t * w.rho * orb.w_max <= share * TOL_PHASE * (1.0 + w.rho * du)
+            and e_d <= share * TOL_IMPULSE * abs(orb.d00) * du)
 
 
-def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: int,
-          step0: float) -> SegmentEnd:
-    """The end of rem (s) of rolling on ``orb`` from (theta, psi) (``w``: its physics, with
-    K0 from the orbit's energy)."""
+def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
+           ) -> tuple[float, complex, complex]:
+    """(x = u - rem/F_00 (rad of psi), P - d00 u (N s), int n dt - n_sec u (s)) of rem (s) of
+    rolling on ``orb`` from (theta, psi), u the spin angle travelled and
+    P = int (N + i F_t) dt: Newton on the orbit's series of t(u), then the periodic parts of
+    the impulses, their series at both ends (int n dt only when a k != 0; else 0). Newton
+    runs on x, with t(u) - rem = (F_00 u_lin - rem) + F_00 x + its periodic part: what
+    varies from start to start is rounded relative to x, not to u (``StepMap`` samples x)."""
     sig, rho1 = w.sig, 1.0 + w.rho
     b_s = psi + w.phi - theta
     eb0 = _powers(cmath.exp(1j * b_s), K_BETA + 1)
     ep0 = _powers(cmath.exp(1j * psi), K_PSI + 1)
     eb0n, ep0n = eb0[1:-1], ep0[1:-1]  # the kept harmonics' powers
     s_t0 = _series(orb.A, eb0n, ep0n)
+    f00 = orb.f00
+    u_lin = rem / f00
+    r0 = f00 * u_lin - rem
 
-    def t_of(u: float) -> float:
+    def residual(x: float) -> float:  # t(u_lin + x) - rem
+        u = u_lin + x
         eb = _powers(cmath.exp(1j * (b_s + rho1 * sig * u)), K_BETA)
         ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI)
-        return orb.f00 * u + 2.0 * (_series(orb.A, eb, ep) - s_t0).real
+        return r0 + f00 * x + 2.0 * (_series(orb.A, eb, ep) - s_t0).real
 
     u = rem * abs(w.Omega0)  # where beta turns at least once: the mean rate; else the
-    u = rem / orb.f00 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u)  # midpoint
+    x = 0.0 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u) - u_lin  # midpoint
     for _ in range(NEWTON_ITERS):  # t' = F = 1/|Omega|; the error after an update of du is
-        du = (t_of(u) - rem) * w._speed(u)  # at most kappa/2 du^2 (kappa >= |F'/F|)
-        u = max(0.0, u - du)
-        if orb.kappa * du * du <= math.ulp(u):
+        du = residual(x) * w._speed(u_lin + x)  # at most kappa/2 du^2 (kappa >= |F'/F|)
+        x = max(-u_lin, x - du)
+        if orb.kappa * du * du <= math.ulp(u_lin + x):
             break
+    u = u_lin + x
     eb = _powers(cmath.exp(1j * (b_s + rho1 * sig * u)), K_BETA + 1)
     ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI + 1)
-    P = orb.d00 * u + _series(orb.B, eb[1:-1], ep[1:-1]) - _series(orb.B, eb0n, ep0n)
-    int_n = (orb.n_sec * u + _series(orb.C, eb, ep) - _series(orb.C, eb0, ep0)
-             if w.akcr else 0j)
+    P = _series(orb.B, eb[1:-1], ep[1:-1]) - _series(orb.B, eb0n, ep0n)
+    int_n = _series(orb.C, eb, ep) - _series(orb.C, eb0, ep0) if w.akcr else 0j
+    return x, P, int_n
+
+
+def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: int,
+          step0: float, solved: tuple[float, complex, complex]) -> SegmentEnd:
+    """The end of rem (s) of rolling on ``orb`` from (theta, psi) (``w``: its physics, with
+    K0 from the orbit's energy) that travels u rad of psi with the periodic parts of the
+    impulses of ``solved`` (``_solve`` or the orbit's ``StepMap``)."""
+    sig, rho1 = w.sig, 1.0 + w.rho
+    x, P, int_n = solved
+    u = rem / orb.f00 + x
+    P += orb.d00 * u
+    int_n = orb.n_sec * u + int_n if w.akcr else 0j
     start, end = w._path(0.0), w._path(u)
     Pc = w.contact_impulse(u, rem, int_n, (start, end))
     _, N, _, om2, th = end

@@ -623,6 +623,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
             orbit_energy=(self._orbit.E if self._orbit is not None
                           and self._mode == MODE_ROLLING else math.nan),
+            orbit_step=(self._orbit.last_rem if self._orbit is not None
+                        and self._mode == MODE_ROLLING else math.nan),
             imb_h=(self._imb_seen_h, self._imb_free_h),
             Omega=self._inputs[0], F_ext=self._inputs[1], amb_on=self._inputs[2],
             bearing=(fixed_bearing_record() if self._race is None
@@ -681,7 +683,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         self._t_contact = cs.t_contact
         self._slide_step = cs.slide_step
         self._orbit = (None if math.isnan(cs.orbit_energy) or cs.J is None else Orbit(
-            cs.orbit_energy, orbit_key(cs.params, cs.J, cs.amb_on, cs.F_ext, cs.Omega)))
+            cs.orbit_energy, orbit_key(cs.params, cs.J, cs.amb_on, cs.F_ext, cs.Omega),
+            cs.orbit_step))
         self._imb_seen_h = cs.imb_h[0]  # the imbalance closed form's choice continues
         if not math.isnan(cs.imb_h[1]):  # (its coefficients: the same bits again)
             c = self._fm.imb_impulse(cs.imb_h[1])

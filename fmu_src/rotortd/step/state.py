@@ -17,7 +17,8 @@ JSON's repr; a complex number is [re, im])::
                   "slip": +-1 (0 before any contact), "locked": bool, "on_wall": bool,
                   "t_contact": s or null (NaN), "slide_step": s or null (inf),
                   "orbit_energy": J or null (NaN; optional: a version 3 document
-                  without it reads as null)},
+                  without it reads as null), "orbit_step": s or null (NaN; optional,
+                  likewise)},
      "counters": {"n_impacts": int, "t_last": s, "v_last": m/s, "E_diss": J},
      "step":     {"F_ext": [N, N], "amb_on": 1, "imb_h": [s or null, s or null]}}
 
@@ -105,6 +106,9 @@ class CoreState:
     orbit_energy: float = math.nan
     """Rolling with the spin a state: the energy (J) of the dry whirl orbit the next step
     continues on (``segments.dry_whirl_orbit``); NaN: none."""
+    orbit_step: float = math.nan
+    """The length (s) of the last segment taken on that orbit (``Orbit.last_rem``: a segment
+    of the same length next uses the orbit's step map); NaN: none."""
 
     @property
     def inputs(self) -> tuple[float, complex, float]:
@@ -195,6 +199,7 @@ FIELDS: tuple[tuple[str, str, Codec], ...] = (
     ("contact.t_contact", "t_contact", NAN_NULL),
     ("contact.slide_step", "slide_step", INF_NULL),
     ("contact.orbit_energy", "orbit_energy", NAN_NULL),
+    ("contact.orbit_step", "orbit_step", NAN_NULL),
     ("counters.n_impacts", "n_impacts", INT),
     ("counters.t_last", "t_last", FLOAT),
     ("counters.v_last", "v_last", FLOAT),
@@ -205,7 +210,7 @@ FIELDS: tuple[tuple[str, str, Codec], ...] = (
 )
 """Every leaf of the version 3 JSON: (its path, the CoreState attribute, its codec)."""
 
-OPTIONAL = frozenset({"contact.orbit_energy"})
+OPTIONAL = frozenset({"contact.orbit_energy", "contact.orbit_step"})
 """Leaves a version 3 document may lack (written before they were added): read as null."""
 
 LEGACY_PATHS = {"H": "contact.slide_step"} | {
