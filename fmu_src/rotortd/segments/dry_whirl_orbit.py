@@ -224,28 +224,28 @@ class StepMap:
 
     def __init__(self, orb: Orbit, w: DryWhirl, h: float) -> None:
         self.h = h
-        us: list[list[float]] = []
+        xs: list[list[float]] = []
         ps: list[list[complex]] = []
         qs: list[list[complex]] = []
         for a in range(N_BETA):  # (rows over psi at one beta)
-            ru, rp, rq = [], [], []
+            rx, rp, rq = [], [], []
             for b in range(N_PSI):
                 psi = 2.0 * math.pi * b / N_PSI
                 g = on_orbit(orb, w, _BG[a], psi)
-                u, P, q = _solve(orb, g, g.theta0, psi, h)
-                ru.append(u)
+                x, P, q = _solve(orb, g, g.theta0, psi, h)
+                rx.append(x)
                 rp.append(P)
                 rq.append(q)
-            us.append(ru)
+            xs.append(rx)
             ps.append(rp)
             qs.append(rq)
-        cu, cp = _dft2(us), _dft2(ps)
-        u_min = h / orb.f00 + min(map(min, us))
-        self.x00 = cu[(0, 0)].real
+        cx, cp = _dft2(xs), _dft2(ps)
+        u_min = h / orb.f00 + min(map(min, xs))
+        self.x00 = cx[(0, 0)].real
         tol_u = MAP_SHARE * min(TOL_PHASE * (1.0 + w.rho * u_min) / w.rho,
                                 TOL_IMPULSE * u_min)  # (u carries the mean impulse d00 u)
         tol_p = MAP_SHARE * TOL_IMPULSE * abs(orb.d00) * u_min
-        self.U, ok_u = _map_rows(cu, tol_u, True)
+        self.U, ok_u = _map_rows(cx, tol_u, True)
         self.P, ok_p = _map_rows(cp, tol_p, False)
         self.Q, ok_q = (_map_rows(_dft2(qs), tol_p / w.akcr, False) if w.akcr
                         else (([], False), True))
