@@ -210,3 +210,18 @@ def test_the_step_map_agrees_with_newton_within_its_share() -> None:
                 assert abs(qm - q) * w.akcr <= 1.1 * tol_p + 1e-15 * abs(orb.d00) * u
             checked += 1
     assert checked >= 100, checked
+
+
+@pytest.mark.parametrize("W", SPEEDS)
+def test_the_step_map_samples_are_rounded_relative_to_x(W: float) -> None:
+    """The map of the benchmark scene's 1e-4 s step is taken at every speed, and the bound
+    of its check harmonics of x (2 sum |c|) is at most 1e-15 of u (docs/notes/
+    dry-whirl-quadrature.md §9: 1.5e-17 to 3.8e-16 of u measured; Newton run on u itself,
+    its samples rounded relative to u, gave 3.6e-15 to 4e-15 of u)."""
+    core = _rolling_core(W)
+    for _ in range(3):
+        core.step(H, amb_on=0.0)
+    m = core._orbit.map
+    assert m is not None and m.ok and m.h == H
+    u = H / core._orbit.f00 + m.x00
+    assert m.check_x <= 1e-15 * u, (m.check_x, u)

@@ -271,6 +271,18 @@ MUTANTS: tuple[Mutant, ...] = (
     M("Q5", "spin quiet lane", "the lane's T_imb without the drive torque's impulse",
       "), (J * (W - W0) - T * h + R0) / h", "), (J * (W - W0) + R0) / h",
       ("tests/test_spin_quiet.py",)),
+    # ---------------------------------------------------------------- dry whirl step map (#26)
+    M("DM1", "dry whirl step map", "the map's u trimmed to the phase tolerance alone (not to "
+      "TOL_IMPULSE of u, which the mean impulse d00 u carries)",
+      "TOL_IMPULSE * u_min)  # (u carries", "1e300 * u_min)  # (u carries",
+      ("tests/test_dry_whirl_orbit.py",)),
+    M("DM2", "dry whirl step map", "the map's choice left out of the state (a restored "
+      "state takes Newton where the run it continues took the map)",
+      "orbit_step=(self._orbit.last_rem if", "orbit_step=(math.nan if",
+      ("tests/test_dry_whirl_orbit.py",)),
+    M("DM3", "dry whirl step map", "Newton on u, not on x (the samples rounded relative to u)",
+      "        return r0 + f00 * x + 2.0", "        return f00 * (u_lin + x) - rem + 2.0",
+      ("tests/test_dry_whirl_orbit.py",)),
 )
 
 

@@ -220,7 +220,7 @@ class StepMap:
     False where the check harmonics alone exceed it, or the orbit's own series exceed the
     rest of the tolerance (Newton then takes the steps)."""
 
-    __slots__ = ("P", "Q", "U", "h", "ok", "x00")
+    __slots__ = ("P", "Q", "U", "check_x", "h", "ok", "x00")
 
     def __init__(self, orb: Orbit, w: DryWhirl, h: float) -> None:
         self.h = h
@@ -245,11 +245,11 @@ class StepMap:
         tol_u = MAP_SHARE * min(TOL_PHASE * (1.0 + w.rho * u_min) / w.rho,
                                 TOL_IMPULSE * u_min)  # (u carries the mean impulse d00 u)
         tol_p = MAP_SHARE * TOL_IMPULSE * abs(orb.d00) * u_min
-        self.U, ok_u = _map_rows(cx, tol_u, True)
-        self.P, ok_p = _map_rows(cp, tol_p, False)
-        self.Q, ok_q = (_map_rows(_dft2(qs), tol_p / w.akcr, False) if w.akcr
-                        else (([], False), True))
-        self.ok = (ok_u and ok_p and ok_q
+        self.U, self.check_x = _map_rows(cx, tol_u, True)
+        self.P, check_p = _map_rows(cp, tol_p, False)
+        self.Q, check_q = (_map_rows(_dft2(qs), tol_p / w.akcr, False) if w.akcr
+                           else (([], False), 0.0))
+        self.ok = (self.check_x <= tol_u and check_p <= tol_p and check_q * w.akcr <= tol_p
                    and _within_tolerance(orb, w, u_min, 1.0 - MAP_SHARE))
 
     def at(self, beta: float, psi: float) -> tuple[float, complex, complex]:
@@ -291,15 +291,15 @@ def _dft2(x: list[list[Any]]) -> dict[tuple[int, int], complex]:
 
 
 def _map_rows(c: dict[tuple[int, int], complex], tol: float, real: bool
-              ) -> tuple[MapRows, bool]:
+              ) -> tuple[MapRows, float]:
     """The rows of ``_series`` for the kept part of a map's series c (for a real function
     the half j > 0 or j = 0 < l, to be doubled and added to c_00), over beta or over psi,
     whichever takes fewer (``_map_series``), smallest terms left out
-    while the check harmonics' bound (2 sum |c|) plus theirs stays within tol; and whether
-    the check harmonics alone are within it."""
+    while the check harmonics' bound (2 sum |c|) plus theirs stays within tol; and that
+    bound of the check harmonics alone."""
     k1, jp1 = K_BETA + 1, K_PSI + 1
-    err = 2.0 * sum(abs(v) for (j, jp), v in c.items() if abs(j) == k1 or abs(jp) == jp1)
-    ok = err <= tol
+    err = check = 2.0 * sum(abs(v) for (j, jp), v in c.items()
+                            if abs(j) == k1 or abs(jp) == jp1)
     kept = {k for k in c if abs(k[0]) < k1 and abs(k[1]) < jp1
             and (k[0] > 0 or (k[0] == 0 and k[1] > 0) if real else True)}
     left = set()
@@ -311,7 +311,7 @@ def _map_rows(c: dict[tuple[int, int], complex], tol: float, real: bool
         left.add(k)
     rows = [_trimmed(lambda j, jp: c[(j, jp)] if (j, jp) in kept and (j, jp) not in left
                      else 0j, 0, by_psi) for by_psi in (False, True)]
-    return (rows[0], False) if len(rows[0]) <= len(rows[1]) else (rows[1], True), ok
+    return (rows[0], False) if len(rows[0]) <= len(rows[1]) else (rows[1], True), check
 
 
 def _small(c: dict[tuple[int, int], complex], scale: float) -> list[tuple[int, int]]:
