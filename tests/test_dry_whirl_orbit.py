@@ -217,11 +217,14 @@ def test_the_step_map_samples_are_rounded_relative_to_x(W: float) -> None:
     """The map of the benchmark scene's 1e-4 s step is taken at every speed, and the bound
     of its check harmonics of x (2 sum |c|) is at most 1e-15 of u (docs/notes/
     dry-whirl-quadrature.md §9: 1.5e-17 to 3.8e-16 of u measured; Newton run on u itself,
-    its samples rounded relative to u, gave 3.6e-15 to 4e-15 of u)."""
+    its samples rounded relative to u, gave 3.6e-15 to 4e-15 of u). At 2000 rad/s, where
+    the truncation is far below it, that bound is below one rounding of u (eps/2 = 1.1e-16
+    of u): the samples are rounded relative to x, not to u (a residual rounded relative
+    to h gives 3.8e-16 of u there)."""
     core = _rolling_core(W)
     for _ in range(3):
         core.step(H, amb_on=0.0)
     m = core._orbit.map
     assert m is not None and m.ok and m.h == H
     u = H / core._orbit.f00 + m.x00
-    assert m.check_x <= 1e-15 * u, (m.check_x, u)
+    assert m.check_x <= (1.1e-16 if W == 2000.0 else 1e-15) * u, (m.check_x, u)

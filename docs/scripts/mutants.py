@@ -280,7 +280,7 @@ MUTANTS: tuple[Mutant, ...] = (
       "state takes Newton where the run it continues took the map)",
       "orbit_step=(self._orbit.last_rem if", "orbit_step=(math.nan if",
       ("tests/test_dry_whirl_orbit.py",)),
-    M("DM3", "dry whirl step map", "Newton on u, not on x (the samples rounded relative to u)",
+    M("DM3", "dry whirl step map", "the residual rounded relative to h, not to x",
       "        return r0 + f00 * x + 2.0", "        return f00 * (u_lin + x) - rem + 2.0",
       ("tests/test_dry_whirl_orbit.py",)),
 )
