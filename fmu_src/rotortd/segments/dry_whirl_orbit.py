@@ -500,7 +500,7 @@ def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: i
     int_n = orb.n_sec * u + int_n if w.akcr else 0j
     start, end = w._path(0.0), w._path(u)
     Pc = w.contact_impulse(u, rem, int_n, (start, end))
-    _, N, _, om2, th, *_ = end
+    _, N, _, om2, th = end
     peak = max(abs(N), abs(start[1]))
     if u * rho1 >= 2.0 * math.pi:  # beta has turned through every phase
         peak = max(peak, orb.peak_on(psi, psi + sig * u))

@@ -225,13 +225,11 @@ class DryWhirl:
         IP = self.I0 - self.c2 * (cE * ct + sE * st)
         return math.sqrt((self.K0 - 2.0 * (dv - self.c_r * (self.Gx * ct + self.Gy * st))) / IP)
 
-    def _path(self, u: float) -> tuple[float, ...]:
-        """(F, N, F_t, Omega^2, theta, cos theta, sin theta, cos(psi + phi), sin(psi + phi))
-        on the path at u."""
+    def _path(self, u: float) -> tuple[float, float, float, float, float]:
+        """(F, N, F_t, Omega^2, theta) on the path at u."""
         th = self.theta0 - self.rho * self.sig * u
         dv, cE, sE = self._dv_psi(u)
-        ct, st = math.cos(th), math.sin(th)
-        return (*self._forces(ct, st, cE, sE, dv), th, ct, st, cE, sE)
+        return (*self._forces(math.cos(th), math.sin(th), cE, sE, dv), th)
 
     # ------------------------------------------------------------------ bounds
 
@@ -335,18 +333,17 @@ class DryWhirl:
         where the caller has them."""
         p0, pu = paths if paths is not None else (self._path(0.0), self._path(u))
         G = complex(self.Gx, self.Gy)
-        return self.m * (self._zg_dot(pu) - self._zg_dot(p0)) - G * dur + self.akcr * int_n
+        return self.m * (self._zg_dot(u, pu) - self._zg_dot(0.0, p0)) - G * dur + self.akcr * int_n
 
-    def _zg_dot(self, path: tuple[float, ...]) -> complex:
-        """The mass centre's velocity z_G' = i Omega (e_c E - R n) (m/s) at a point of the path
-        (``_path``: Omega^2 and the cosines and sines of theta and psi + phi there)."""
-        om2, _, ct, st, cE, sE = path[3:]
-        return 1j * self.sig * math.sqrt(om2) * (self.e_c * complex(cE, sE)
-                                                 - self.R * complex(ct, st))
+    def _zg_dot(self, u: float, path: tuple[float, ...]) -> complex:
+        """The mass centre's velocity z_G' (m/s) at u from ``_path(u)``."""
+        om2, th = path[3], path[4]
+        E = cmath.exp(1j * (self.psi0 + self.sig * u + self.phi))
+        return 1j * self.sig * math.sqrt(om2) * (self.e_c * E - self.R * cmath.exp(1j * th))
 
     def _end(self, panel: _DirectPanel | _LevinPanel, u: float, dur: float, work: int,
              step0: float) -> SegmentEnd:
-        _, N, _, om2, th, *_ = self._path(u)
+        _, N, _, om2, th = self._path(u)
         Om = self.sig * math.sqrt(om2)
         P, Pc = panel.impulses(u, dur)
         mc = self.m * self.c_r  # the tally is per unit m c_r (wall.ContactTally)
@@ -388,10 +385,10 @@ class _DirectPanel:
         self.us = [0.5 * L * (1.0 + x) for x in _XD]
         self.Ns = []
         for u in self.us:
-            F, N, Ft, _, _, ct, st, _, _ = w._path(u)
+            F, N, Ft, _, th = w._path(u)
             fs.append(F)
             ds.append(complex(N * F, Ft * F))
-            ns.append(F * complex(ct, st))
+            ns.append(F * cmath.exp(1j * th))
             self.Ns.append(abs(N))
         self.af = [sum(map(mul, fs, row)) for row in _CHD]
         self.ad = [sum(map(mul, ds, row)) for row in _CHD]
