@@ -266,7 +266,7 @@ def on_orbit(orb: Orbit, w: DryWhirl, beta: float, psi: float) -> DryWhirl:
     """The physics (``w``'s held inputs) of the state at (beta, psi) (rad) on ``orb``: theta
     = psi + phi - beta, Omega (in w's direction) and K0 from the orbit's energy."""
     g = DryWhirl(w.h, psi + w.phi - beta, psi, w.sig)
-    g.K0 = 2.0 * (orb.E - (-g.v0 + g.mge * g.sE0))
+    g.K0 = _k0_on(orb, g)
     g.Omega0 = w.sig * math.sqrt(g.K0 / (w.I0 - w.c2 * math.cos(beta)))
     return g
 
@@ -373,6 +373,12 @@ def energy(w: DryWhirl) -> float:
     return 0.5 * w.K0 - w.v0 + w.mge * w.sE0
 
 
+def _k0_on(orb: Orbit, w: DryWhirl) -> float:
+    """I_P Omega^2 = 2 (E - V) (J) at ``w``'s start on the orbit of energy E (the
+    integral's K0 of ``w``, from the orbit's energy rather than the state's speed)."""
+    return 2.0 * (orb.E - (-w.v0 + w.mge * w.sE0))
+
+
 def _powers(e: complex, k: int) -> list[complex]:
     """[e^-k, ..., e^k] for |e| = 1."""
     pos = [1.0 + 0j]
@@ -415,7 +421,7 @@ def advance(prev: Orbit | None, h: HeldInputs, theta: float, psi: float, Omega: 
     cost = build_work + SAMPLE_WORK * (2 * NEWTON_ITERS + 5)
     if cost > limit:
         return None, orb
-    w.K0 = 2.0 * (orb.E - (-w.v0 + w.mge * w.sE0))  # Omega^2 on the path from the orbit's E
+    w.K0 = _k0_on(orb, w)  # Omega^2 on the path from the orbit's E
     if not _within_tolerance(orb, w, rem * abs(Omega)):
         return None, orb
     return _step(orb, w, theta, psi, rem, cost, step0, _mapped(orb, w, theta, psi, rem, limit)
