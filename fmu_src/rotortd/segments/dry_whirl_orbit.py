@@ -97,9 +97,10 @@ _PSI_ROWS = [[cmath.exp(-1j * jp * 2.0 * math.pi * b / N_PSI) / N_PSI for b in r
 """_PSI_ROWS[l + K_PSI + 1][b] = e^{-i l psi_b}/N_PSI: the DFT rows in psi."""
 
 Key = tuple[Any, ...]
-Row = tuple[int, int, int, list[complex]]
-"""One row of a 2-D series (``_trimmed``): an index into the outer powers, the span into
-the inner powers and the coefficients over it."""
+Row = tuple[int, int, complex, list[complex]]
+"""One row of a 2-D series (``_trimmed``): an index into the outer powers, the index into
+the inner powers of its lowest power, and its coefficients for Horner's rule (the highest
+power's, then the rest from the highest down)."""
 
 
 def orbit_key(p: RotorParams, J: float, a: float, F_ext: complex, Omega: float) -> Key:
@@ -336,9 +337,9 @@ def _trimmed(coef: Any, wide: int, by_psi: bool = False) -> list[Row]:
     """The rows j = -K_BETA-wide .. K_BETA+wide over l = -K_PSI-wide .. K_PSI+wide of
     coef(j, l) (the coefficients of a sum ``_series`` evaluates: the kept harmonics,
     wide = 0; one more each way for int n dt, wide = 1), each cut to the span of its nonzero
-    entries: (row index into the beta powers, first and end index into the psi powers, the
-    coefficients); rows without any left out. ``by_psi``: the rows over l instead, each
-    over j (indices into the psi powers, then the beta powers)."""
+    entries (``Row``: the row's index into the beta powers, its first index into the psi
+    powers, its coefficients for Horner's rule); rows without any left out. ``by_psi``: the
+    rows over l instead, each over j (indices into the psi powers, then the beta powers)."""
     outer = range(-K_PSI - wide, K_PSI + wide + 1) if by_psi else range(
         -K_BETA - wide, K_BETA + wide + 1)
     inner = range(-K_BETA - wide, K_BETA + wide + 1) if by_psi else range(
@@ -348,7 +349,7 @@ def _trimmed(coef: Any, wide: int, by_psi: bool = False) -> list[Row]:
         row = [coef(i, k) if by_psi else coef(k, i) for i in inner]
         nz = [i for i, x in enumerate(row) if x]
         if nz:
-            out.append((a, nz[0], nz[-1] + 1, row[nz[0]:nz[-1] + 1]))
+            out.append((a, nz[0], row[nz[-1]], row[nz[0]:nz[-1]][::-1]))
     return out
 
 
@@ -389,8 +390,16 @@ def _powers(e: complex, k: int) -> list[complex]:
 
 def _series(rows: list[Row], eb: list[complex], ep: list[complex]) -> complex:
     """sum_jl c_jl e^{i j beta} e^{i l psi} over the rows of ``_trimmed`` from the power lists
-    of e^{i beta} and e^{i psi} (``_powers``, of the rows' width)."""
-    return sum([eb[a] * sum(map(mul, c, ep[lo:hi])) for a, lo, hi, c in rows])
+    of e^{i beta} and e^{i psi} (``_powers``, of the rows' width): each row by Horner's rule
+    in e^{i psi} (two thirds of the instructions of the sum of products, whose complex
+    operations allocate twice a term; docs/notes/dry-whirl-quadrature.md §9), then times
+    its lowest powers."""
+    z, s = ep[len(ep) // 2 + 1], 0j
+    for a, lo, acc, rest in rows:
+        for c in rest:
+            acc = acc * z + c
+        s += eb[a] * ep[lo] * acc
+    return s
 
 
 def advance(prev: Orbit | None, h: HeldInputs, theta: float, psi: float, Omega: float,
