@@ -97,10 +97,9 @@ _PSI_ROWS = [[cmath.exp(-1j * jp * 2.0 * math.pi * b / N_PSI) / N_PSI for b in r
 """_PSI_ROWS[l + K_PSI + 1][b] = e^{-i l psi_b}/N_PSI: the DFT rows in psi."""
 
 Key = tuple[Any, ...]
-Row = tuple[int, int, complex, list[complex]]
-"""One row of a 2-D series (``_trimmed``): an index into the outer powers, the index into
-the inner powers of its lowest power, and its coefficients for Horner's rule (the highest
-power's, then the rest from the highest down)."""
+Row = tuple[float, float, complex, list[complex]]
+"""One row of a 2-D series (``_trimmed``): the harmonic (j, l) of its lowest term and its
+coefficients for Horner's rule (the highest term's, then the rest from the highest down)."""
 
 
 def orbit_key(p: RotorParams, J: float, a: float, F_ext: complex, Omega: float) -> Key:
@@ -256,11 +255,10 @@ class StepMap:
     def at(self, beta: float, psi: float) -> tuple[float, complex, complex]:
         """``_solve``'s (x = u - h/F_00 (rad), P - d00 u (N s), int n dt - n_sec u (s)) of
         the step of h from (beta, psi) (rad)."""
-        eb = _powers(cmath.exp(1j * beta), K_BETA)
-        ep = _powers(cmath.exp(1j * psi), K_PSI)
-        x = self.x00 + 2.0 * _map_series(self.U, eb, ep).real
-        return (x, _map_series(self.P, eb, ep),
-                _map_series(self.Q, eb, ep) if self.Q[0] else 0j)
+        zs = (cmath.exp(1j * psi), cmath.exp(1j * beta))  # (the bases of Horner's rule)
+        x = self.x00 + 2.0 * _map_series(self.U, beta, psi, zs).real
+        return (x, _map_series(self.P, beta, psi, zs),
+                _map_series(self.Q, beta, psi, zs) if self.Q[0] else 0j)
 
 
 def on_orbit(orb: Orbit, w: DryWhirl, beta: float, psi: float) -> DryWhirl:
@@ -276,9 +274,11 @@ MapRows = tuple[list[Row], bool]
 """A map's series: its rows (``_trimmed``) and whether they run over psi."""
 
 
-def _map_series(rows: MapRows, eb: list[complex], ep: list[complex]) -> complex:
-    """``_series`` of a map's rows (``_map_rows``: over beta, or over psi when flagged)."""
-    return _series(rows[0], ep, eb) if rows[1] else _series(rows[0], eb, ep)
+def _map_series(rows: MapRows, beta: float, psi: float, zs: tuple[complex, complex]
+                ) -> complex:
+    """``_series`` of a map's rows (``_map_rows``: over psi, or over beta when flagged) at
+    (beta, psi) (rad), zs = (e^{i psi}, e^{i beta})."""
+    return _series(rows[0], beta, psi, zs[rows[1]])
 
 
 def _dft2(x: list[list[Any]]) -> dict[tuple[int, int], complex]:
@@ -337,19 +337,19 @@ def _trimmed(coef: Any, wide: int, by_psi: bool = False) -> list[Row]:
     """The rows j = -K_BETA-wide .. K_BETA+wide over l = -K_PSI-wide .. K_PSI+wide of
     coef(j, l) (the coefficients of a sum ``_series`` evaluates: the kept harmonics,
     wide = 0; one more each way for int n dt, wide = 1), each cut to the span of its nonzero
-    entries (``Row``: the row's index into the beta powers, its first index into the psi
-    powers, its coefficients for Horner's rule); rows without any left out. ``by_psi``: the
-    rows over l instead, each over j (indices into the psi powers, then the beta powers)."""
+    entries (``Row``: the harmonic of its lowest term, its coefficients for Horner's rule);
+    rows without any left out. ``by_psi``: the rows over l instead, each over j."""
     outer = range(-K_PSI - wide, K_PSI + wide + 1) if by_psi else range(
         -K_BETA - wide, K_BETA + wide + 1)
     inner = range(-K_BETA - wide, K_BETA + wide + 1) if by_psi else range(
         -K_PSI - wide, K_PSI + wide + 1)
     out = []
-    for a, k in enumerate(outer):
+    for k in outer:
         row = [coef(i, k) if by_psi else coef(k, i) for i in inner]
         nz = [i for i, x in enumerate(row) if x]
         if nz:
-            out.append((a, nz[0], row[nz[-1]], row[nz[0]:nz[-1]][::-1]))
+            lo, top, rest = float(inner[nz[0]]), row[nz[-1]], row[nz[0]:nz[-1]][::-1]
+            out.append((lo, float(k), top, rest) if by_psi else (float(k), lo, top, rest))
     return out
 
 
@@ -380,25 +380,17 @@ def _k0_on(orb: Orbit, w: DryWhirl) -> float:
     return 2.0 * (orb.E - (-w.v0 + w.mge * w.sE0))
 
 
-def _powers(e: complex, k: int) -> list[complex]:
-    """[e^-k, ..., e^k] for |e| = 1."""
-    pos = [1.0 + 0j]
-    for _ in range(k):
-        pos.append(pos[-1] * e)
-    return [*map(complex.conjugate, pos[:0:-1]), *pos]
-
-
-def _series(rows: list[Row], eb: list[complex], ep: list[complex]) -> complex:
-    """sum_jl c_jl e^{i j beta} e^{i l psi} over the rows of ``_trimmed`` from the power lists
-    of e^{i beta} and e^{i psi} (``_powers``, of the rows' width): each row by Horner's rule
-    in e^{i psi} (two thirds of the instructions of the sum of products, whose complex
-    operations allocate twice a term; docs/notes/dry-whirl-quadrature.md §9), then times
-    its lowest powers."""
-    z, s = ep[len(ep) // 2 + 1], 0j
-    for a, lo, acc, rest in rows:
+def _series(rows: list[Row], beta: float, psi: float, z: complex) -> complex:
+    """sum_jl c_jl e^{i (j beta + l psi)} at (beta, psi) (rad) over the rows of ``_trimmed``,
+    z = e^{i psi} for rows over psi (e^{i beta} for rows over beta): each row by Horner's
+    rule in z, times e^{i (j beta + l psi)} of its lowest term (two thirds of the
+    instructions of the sum of products over power lists, whose complex operations
+    allocate twice a term; docs/notes/dry-whirl-quadrature.md §9)."""
+    s = 0j
+    for j, jp, acc, rest in rows:
         for c in rest:
             acc = acc * z + c
-        s += eb[a] * ep[lo] * acc
+        s += cmath.exp(1j * (j * beta + jp * psi)) * acc
     return s
 
 
@@ -474,19 +466,17 @@ def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
     varies from start to start is rounded relative to x, not to u (``StepMap`` samples x)."""
     sig, rho1 = w.sig, 1.0 + w.rho
     b_s = psi + w.phi - theta
-    eb0 = _powers(cmath.exp(1j * b_s), K_BETA + 1)
-    ep0 = _powers(cmath.exp(1j * psi), K_PSI + 1)
-    eb0n, ep0n = eb0[1:-1], ep0[1:-1]  # the kept harmonics' powers
-    s_t0 = _series(orb.A, eb0n, ep0n)
+    z0 = cmath.exp(1j * psi)
+    s_t0 = _series(orb.A, b_s, psi, z0)
     f00 = orb.f00
     u_lin = rem / f00
     r0 = f00 * u_lin - rem
 
     def residual(x: float) -> float:  # t(u_lin + x) - rem
         u = u_lin + x
-        eb = _powers(cmath.exp(1j * (b_s + rho1 * sig * u)), K_BETA)
-        ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI)
-        return r0 + f00 * x + 2.0 * (_series(orb.A, eb, ep) - s_t0).real
+        p = psi + sig * u
+        s_t = _series(orb.A, b_s + rho1 * sig * u, p, cmath.exp(1j * p))
+        return r0 + f00 * x + 2.0 * (s_t - s_t0).real
 
     u = rem * abs(w.Omega0)  # where beta turns at least once: the mean rate; else the
     x = 0.0 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u) - u_lin  # midpoint
@@ -496,10 +486,10 @@ def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
         if orb.kappa * du * du <= math.ulp(u_lin + x):
             break
     u = u_lin + x
-    eb = _powers(cmath.exp(1j * (b_s + rho1 * sig * u)), K_BETA + 1)
-    ep = _powers(cmath.exp(1j * (psi + sig * u)), K_PSI + 1)
-    P = _series(orb.B, eb[1:-1], ep[1:-1]) - _series(orb.B, eb0n, ep0n)
-    int_n = _series(orb.C, eb, ep) - _series(orb.C, eb0, ep0) if w.akcr else 0j
+    b, p = b_s + rho1 * sig * u, psi + sig * u
+    z = cmath.exp(1j * p)
+    P = _series(orb.B, b, p, z) - _series(orb.B, b_s, psi, z0)
+    int_n = _series(orb.C, b, p, z) - _series(orb.C, b_s, psi, z0) if w.akcr else 0j
     return x, P, int_n
 
 
