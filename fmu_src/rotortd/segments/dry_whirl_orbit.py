@@ -220,7 +220,7 @@ class StepMap:
     False where the check harmonics alone exceed it, or the orbit's own series exceed the
     rest of the tolerance (Newton then takes the steps)."""
 
-    __slots__ = ("P", "Q", "U", "check_x", "h", "ok", "x00")
+    __slots__ = ("P", "Q", "U", "check_x", "every_step", "h", "ok", "x00")
 
     def __init__(self, orb: Orbit, w: DryWhirl, h: float) -> None:
         self.h = h
@@ -240,7 +240,7 @@ class StepMap:
             ps.append(rp)
             qs.append(rq)
         cx, cp = _dft2(xs), _dft2(ps)
-        u_min = h / orb.f00 + min(map(min, xs))
+        u_min, u_max = (h / orb.f00 + f(map(f, xs)) for f in (min, max))
         self.x00 = cx[(0, 0)].real
         tol_u = MAP_SHARE * min(TOL_PHASE * (1.0 + w.rho * u_min) / w.rho,
                                 TOL_IMPULSE * u_min)  # (u carries the mean impulse d00 u)
@@ -250,7 +250,12 @@ class StepMap:
         self.Q, check_q = (_map_rows(_dft2(qs), tol_p / w.akcr, False) if w.akcr
                            else (([], False), 0.0))
         self.ok = (self.check_x <= tol_u and check_p <= tol_p and check_q * w.akcr <= tol_p
-                   and _within_tolerance(orb, w, u_min, 1.0 - MAP_SHARE))
+                   and _within_tolerance(orb, w, u_min, 1.0 - MAP_SHARE, u_max))
+        lo2 = _omega2_bounds(w, orb.E)[0]
+        self.every_step = lo2 > 0.0 and _within_tolerance(
+            orb, w, h * math.sqrt(lo2) * (1.0 - 1e-9), 1.0, h * orb.w_max * (1.0 + 1e-9))
+        """``advance``'s check of the orbit's error holds for every step of h on the orbit
+        (its du = h |Omega| lies between h times the bounds of |Omega| on it): not made."""
 
     def at(self, beta: float, psi: float) -> tuple[float, complex, complex]:
         """``_solve``'s (x = u - h/F_00 (rad), P - d00 u (N s), int n dt - n_sec u (s)) of
@@ -423,7 +428,9 @@ def advance(prev: Orbit | None, h: HeldInputs, theta: float, psi: float, Omega: 
     if cost > limit:
         return None, orb
     w.K0 = _k0_on(orb, w)  # Omega^2 on the path from the orbit's E
-    if not _within_tolerance(orb, w, rem * abs(Omega)):
+    m = orb.map
+    if not (m is not None and m.h == rem and m.every_step) and not _within_tolerance(
+            orb, w, rem * abs(Omega)):
         return None, orb
     return _step(orb, w, theta, psi, rem, cost, step0, _mapped(orb, w, theta, psi, rem, limit)
                  or _solve(orb, w, theta, psi, rem)), orb
@@ -444,14 +451,18 @@ def _mapped(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, limit
     return m.at(psi + w.phi - theta, psi) if m.ok else None
 
 
-def _within_tolerance(orb: Orbit, w: DryWhirl, du: float, share: float = 1.0) -> bool:
+def _within_tolerance(orb: Orbit, w: DryWhirl, du: float, share: float = 1.0,
+                      du_err: float | None = None) -> bool:
     """The dropped harmonics' error over a step of du rad of psi within ``share`` of
     TOL_PHASE (1 + its turn of theta) rad of theta and of TOL_IMPULSE of its mean impulse.
-    Each dropped term integrates to at most |c_jl| min(du, 2/|w_jl|) (``_dropped``)."""
+    Each dropped term integrates to at most |c_jl| min(du, 2/|w_jl|) (``_dropped``).
+    ``du_err`` >= du: the errors taken at du_err, the tolerances at du, so that the check
+    holds for every step from du to du_err rad (both grow with the step)."""
+    de = du if du_err is None else du_err
     a, b, c = orb.err_t
-    e_t = min(a, b * du) + c * du
+    e_t = min(a, b * de) + c * de
     a, b, c = orb.err_d
-    e_d = min(a, b * du) + c * du + w.akcr * e_t
+    e_d = min(a, b * de) + c * de + w.akcr * e_t
     return (e_t * w.rho * orb.w_max <= share * TOL_PHASE * (1.0 + w.rho * du)
             and e_d <= share * TOL_IMPULSE * abs(orb.d00) * du)
 

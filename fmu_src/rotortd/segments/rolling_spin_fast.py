@@ -156,7 +156,7 @@ class DryWhirl:
         cb0 = math.cos(psi + p.phi - theta)
         self.K0 = (self.I0 - self.c2 * cb0) * Omega * Omega  # I_P(beta0) Omega0^2 (J)
         self.ct0, self.st0 = math.cos(theta), math.sin(theta)
-        self.sE0 = math.sin(psi + p.phi)
+        self.cE0, self.sE0 = math.cos(psi + p.phi), math.sin(psi + p.phi)
         self.v0 = self.c_r * (self.Gx * self.ct0 + self.Gy * self.st0)  # -(theta part of V0)
 
     # ------------------------------------------------------------------ the physics
@@ -226,7 +226,10 @@ class DryWhirl:
         return math.sqrt((self.K0 - 2.0 * (dv - self.c_r * (self.Gx * ct + self.Gy * st))) / IP)
 
     def _path(self, u: float) -> tuple[float, float, float, float, float]:
-        """(F, N, F_t, Omega^2, theta) on the path at u."""
+        """(F, N, F_t, Omega^2, theta) on the path at u (at u = 0 from the start's cosines and
+        sines, the same values)."""
+        if u == 0.0:
+            return (*self._forces(self.ct0, self.st0, self.cE0, self.sE0, self.v0), self.theta0)
         th = self.theta0 - self.rho * self.sig * u
         dv, cE, sE = self._dv_psi(u)
         return (*self._forces(math.cos(th), math.sin(th), cE, sE, dv), th)

@@ -187,7 +187,8 @@ class SpinContact:
         self.dth_per_W = -h.p.R / h.p.c_r
         self._start = (theta, dtheta, psi, Omega)
         self._ready = False
-        if not self._orbit_applies():
+        self._on_orbit = self._orbit_applies()
+        if not self._on_orbit:
             self._setup()
 
     def _orbit_applies(self) -> bool:
@@ -255,7 +256,7 @@ class SpinContact:
     def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
         orbit = None  # declared accelerators (docs/notes/dry-whirl-quadrature.md):
-        if self._orbit_applies():  # None = not here
+        if self._on_orbit:  # None = not here
             fast, orbit = dry_whirl_orbit.advance(self.orbit, self.h, *self.y0, rem, limit,
                                                   self.step0)
             if fast is not None:
