@@ -77,6 +77,7 @@ def errors_against_the_integrator(h: HeldInputs, th: float, psi: float, W: float
     seg = SpinContact(h, 0.0, th, 0.0, psi, W)
     seg.accelerate = False
     old = seg.run(new.duration, 10 ** 9)
+    assert old.orbit is None  # (the integrator took it: the orbit's ends carry their orbit)
     assert old.event is None and new.event is None
     mc = h.p.m * h.p.c_r
     tal = old.tally

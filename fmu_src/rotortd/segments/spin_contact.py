@@ -175,9 +175,11 @@ class SpinContact:
 
     def __init__(self, h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
                  Omega: float, step0: float = math.inf, n_slack: float = 0.0,
-                 orbit: dry_whirl_orbit.Orbit | None = None) -> None:
+                 orbit: dry_whirl_orbit.Orbit | None = None, asked: bool = False) -> None:
         self.h, self.s = h, s
         self.orbit = orbit  # rolling: the dry whirl orbit of the previous step, if any
+        self.asked = asked  # the orbit refused this segment already, and ``orbit`` is its
+        # answer (``SpinSteps._spin_roll_step``): not asked again
         self.n_slack = n_slack  # N (N): lift-off only once N < -n_slack
         self.rolling = s == 0.0
         self.y0: Vector = ([theta, psi, Omega] if self.rolling
@@ -187,15 +189,16 @@ class SpinContact:
         self.dth_per_W = -h.p.R / h.p.c_r
         self._start = (theta, dtheta, psi, Omega)
         self._ready = False
-        self._on_orbit = self._orbit_applies()
+        self._on_orbit = not asked and self.orbit_applies(h, self.rolling)
         if not self._on_orbit:
             self._setup()
 
-    def _orbit_applies(self) -> bool:
+    @classmethod
+    def orbit_applies(cls, h: HeldInputs, rolling: bool) -> bool:
         """The orbit (``dry_whirl_orbit``) is tried first: rolling, the accelerators on,
         a c = 0 and T_drive = 0."""
-        return (self.rolling and self.accelerate and self.follow_orbit
-                and self.h.T_drive == 0.0 and rolling_spin_fast.applies(self.h))
+        return (rolling and cls.accelerate and cls.follow_orbit
+                and h.T_drive == 0.0 and rolling_spin_fast.applies(h))
 
     def _setup(self) -> None:
         """The contact model, the integrator's step bounds and tolerances (not built where
@@ -255,8 +258,10 @@ class SpinContact:
 
     def run(self, rem: float, limit: int = WORK_MAX) -> SegmentEnd:
         """Advance at most rem (s) and limit work units; stop at the first event."""
-        orbit = None  # declared accelerators (docs/notes/dry-whirl-quadrature.md):
-        if self._on_orbit:  # None = not here
+        orbit = self.orbit if self.asked else None  # declared accelerators
+        # (docs/notes/dry-whirl-quadrature.md; as set on the class at construction and on
+        # the instance now); None = not here
+        if self._on_orbit and self.accelerate and self.follow_orbit:
             fast, orbit = dry_whirl_orbit.advance(self.orbit, self.h, *self.y0, rem, limit,
                                                   self.step0)
             if fast is not None:
