@@ -29,6 +29,7 @@ from dataclasses import replace
 
 import pytest
 from rotortd import SpinCore
+from rotortd.contact.search import SEGMENT_WORK
 from rotortd.params import RotorParams
 from rotortd.segments import dry_whirl_orbit as orbit_mod
 from rotortd.segments.rolling_spin_fast import DryWhirl
@@ -150,6 +151,44 @@ def test_the_orbit_carries_over_steps_and_states() -> None:
     assert math.isnan(older.state.orbit_energy)
     older.step(H, amb_on=0.0)
     assert older.mode == 2 and not math.isnan(older.state.orbit_energy)
+
+
+def test_a_rolling_step_asks_the_orbit_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The core's rolling step asks the orbit first (``SpinSteps._spin_roll_step``); where
+    it refuses, the step loop's segment takes its answer and does not ask again (a second
+    ask would charge the orbit's build twice and could build its step map early); and a
+    refused orbit leaves the step to the panels as if there were none, to the bit."""
+    answers: list[bool] = []
+    real = orbit_mod.advance
+
+    def counted(*args: object) -> tuple[object, object]:
+        out = real(*args)  # type: ignore[arg-type]
+        answers.append(out[0] is not None)
+        return out
+
+    monkeypatch.setattr(orbit_mod, "advance", counted)
+    core = _rolling_core(2000.0)
+    for _ in range(4):
+        core.step(H, amb_on=0.0)
+    assert answers == [True] * 4
+    answers.clear()
+    core.step(H, amb_on=0.0, budget=SEGMENT_WORK + 10)  # below the orbit's cost
+    assert answers == [False]
+    wobbly = {**CHAPTER, "e_c": 2e-3}  # c2 > DELTA_MAX I0: the series would not converge
+    runs = []
+    for follow in (True, False):
+        monkeypatch.setattr(SpinContact, "follow_orbit", follow)
+        p = RotorParams(**wobbly)
+        core = SpinCore(p, J, Omega0=2000.0)
+        th, dth = -math.pi / 2, -p.R * 2000.0 / p.c_r
+        n = cmath.exp(1j * th)
+        core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0,
+                               z=p.c_r * n, v=1j * p.c_r * dth * n))
+        answers.clear()
+        runs.append([core.step(H, amb_on=0.0).work for _ in range(3)] + [core.get_state()])
+        assert core.mode == 2
+        assert answers == ([False] * 3 if follow else [])
+    assert runs[0] == runs[1]
 
 
 def test_work_does_not_depend_on_the_speed() -> None:

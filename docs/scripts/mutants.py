@@ -283,6 +283,10 @@ MUTANTS: tuple[Mutant, ...] = (
     M("DM3", "dry whirl step map", "the residual rounded relative to h, not to x",
       "        return r0 + f00 * x + 2.0", "        return f00 * (u_lin + x) - rem + 2.0",
       ("tests/test_dry_whirl_orbit.py",)),
+    M("DM4", "dry whirl step map", "the step loop asks the orbit again after the core's "
+      "rolling step was refused by it (the build charged twice, the map built early)",
+      "        st.orbit_asked = asked", "        st.orbit_asked = False",
+      ("tests/test_dry_whirl_orbit.py",)),
 )
 
 

@@ -260,7 +260,7 @@ class StepMap:
     def at(self, beta: float, psi: float) -> tuple[float, complex, complex]:
         """``_solve``'s (x = u - h/F_00 (rad), P - d00 u (N s), int n dt - n_sec u (s)) of
         the step of h from (beta, psi) (rad)."""
-        zs = (cmath.exp(1j * psi), cmath.exp(1j * beta))  # (the bases of Horner's rule)
+        zs = (cmath.rect(1.0, psi), cmath.rect(1.0, beta))  # (the bases of Horner's rule)
         x = self.x00 + 2.0 * _map_series(self.U, beta, psi, zs).real
         return (x, _map_series(self.P, beta, psi, zs),
                 _map_series(self.Q, beta, psi, zs) if self.Q[0] else 0j)
@@ -388,14 +388,15 @@ def _k0_on(orb: Orbit, w: DryWhirl) -> float:
 def _series(rows: list[Row], beta: float, psi: float, z: complex) -> complex:
     """sum_jl c_jl e^{i (j beta + l psi)} at (beta, psi) (rad) over the rows of ``_trimmed``,
     z = e^{i psi} for rows over psi (e^{i beta} for rows over beta): each row by Horner's
-    rule in z, times e^{i (j beta + l psi)} of its lowest term (two thirds of the
-    instructions of the sum of products over power lists, whose complex operations
-    allocate twice a term; docs/notes/dry-whirl-quadrature.md §9)."""
+    rule in z, times e^{i (j beta + l psi)} of its lowest term (cmath.rect, cmath.exp's
+    values without building i x). Two thirds of the instructions of the sum of products
+    over power lists, whose complex operations allocate twice a term
+    (docs/notes/dry-whirl-quadrature.md §9)."""
     s = 0j
     for j, jp, acc, rest in rows:
         for c in rest:
             acc = acc * z + c
-        s += cmath.exp(1j * (j * beta + jp * psi)) * acc
+        s += cmath.rect(1.0, j * beta + jp * psi) * acc
     return s
 
 
@@ -477,7 +478,7 @@ def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
     varies from start to start is rounded relative to x, not to u (``StepMap`` samples x)."""
     sig, rho1 = w.sig, 1.0 + w.rho
     b_s = psi + w.phi - theta
-    z0 = cmath.exp(1j * psi)
+    z0 = cmath.rect(1.0, psi)
     s_t0 = _series(orb.A, b_s, psi, z0)
     f00 = orb.f00
     u_lin = rem / f00
@@ -486,7 +487,7 @@ def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
     def residual(x: float) -> float:  # t(u_lin + x) - rem
         u = u_lin + x
         p = psi + sig * u
-        s_t = _series(orb.A, b_s + rho1 * sig * u, p, cmath.exp(1j * p))
+        s_t = _series(orb.A, b_s + rho1 * sig * u, p, cmath.rect(1.0, p))
         return r0 + f00 * x + 2.0 * (s_t - s_t0).real
 
     u = rem * abs(w.Omega0)  # where beta turns at least once: the mean rate; else the
@@ -498,7 +499,7 @@ def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
             break
     u = u_lin + x
     b, p = b_s + rho1 * sig * u, psi + sig * u
-    z = cmath.exp(1j * p)
+    z = cmath.rect(1.0, p)
     P = _series(orb.B, b, p, z) - _series(orb.B, b_s, psi, z0)
     int_n = _series(orb.C, b, p, z) - _series(orb.C, b_s, psi, z0) if w.akcr else 0j
     return x, P, int_n
@@ -524,7 +525,8 @@ def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: i
         peak = max(peak, abs(w._path(0.5 * u)[1]))
     Om = sig * math.sqrt(om2)
     mc = w.m * w.c_r  # the tally is per unit m c_r (wall.ContactTally)
-    tally = ContactTally(I_n=P.real / mc, I_c=Pc / mc, I_t=P.imag / mc, I_e=0.0,
-                         peak=peak / mc, work=work)
-    return SegmentEnd(rem, th, -w.rho * Om, None, tally, step0, psi=psi + sig * u, Omega=Om,
-                      work=work, orbit=orb)
+    tally = ContactTally(P.real / mc, Pc / mc, P.imag / mc, 0.0, peak / mc, work)
+    # (I_n, I_c, I_t, I_e, peak, work; then SegmentEnd's fields in order, z = v = 0j:
+    # positional, a step's end every step on the orbit)
+    return SegmentEnd(rem, th, -w.rho * Om, None, tally, step0, 0j, 0j, psi + sig * u, Om,
+                      work, orb)

@@ -149,6 +149,7 @@ class DryWhirl:
         self.mge = p.m * p.g * p.e_c
         self.akcr = h.a * p.k * p.c_r
         self.rho = p.R / p.c_r
+        self.cen = p.m * p.c_r * self.rho * self.rho  # m c_r rho^2: N = cen Omega^2 + ... (kg m)
         self.sig = 1.0 if Omega >= 0.0 else -1.0
         self.theta0, self.psi0, self.Omega0 = theta, psi, Omega
         self.I0 = self.J + p.m * (p.R * p.R + p.e_c * p.e_c)
@@ -175,10 +176,10 @@ class DryWhirl:
         m, e_c = self.m, self.e_c
         cb, sb = cE * ct + sE * st, sE * ct - cE * st
         IP = self.I0 - self.c2 * cb
-        om2 = (self.K0 - 2.0 * (dv - self.c_r * (self.Gx * ct + self.Gy * st))) / IP
+        g_r = self.Gx * ct + self.Gy * st
+        om2 = (self.K0 - 2.0 * (dv - self.c_r * g_r)) / IP
         U = m * e_c * om2
-        rn = (self.Gx * ct + self.Gy * st - self.akcr + U * cb
-              + m * self.c_r * self.rho * self.rho * om2)
+        rn = g_r - self.akcr + U * cb + self.cen * om2
         Fot = self.Gy * ct - self.Gx * st + U * sb
         T = self.T + e_c * (self.F1x * sE - self.F1y * cE) - self.akcr * e_c * sb
         B, A = e_c * sb, self.R - e_c * cb
@@ -199,7 +200,7 @@ class DryWhirl:
         ``_forces`` written for a grid (the Fourier-Levin panel's and the orbit's samples;
         tests/test_dry_whirl_orbit.py checks them against ``_forces``)."""
         m, e_c, c_r, akcr, Gx, Gy = self.m, self.e_c, self.c_r, self.akcr, self.Gx, self.Gy
-        cen = m * c_r * self.rho * self.rho
+        cen = self.cen
         T = self.T + e_c * (self.F1x * sE - self.F1y * cE)
         fs, ds, ns = [], [], []
         for cb, sb, IP, B, A in zip(*grid):
@@ -248,10 +249,10 @@ class DryWhirl:
     def _no_event(self, lo: float, hi: float) -> bool:
         """N > 0 and |F_t| < mu N at every (theta, psi) of the panel and every Omega^2 in
         [lo, hi] (docs/notes/dry-whirl-quadrature.md §4)."""
-        m, R, e_c, c_r = self.m, self.R, self.e_c, self.c_r
+        m, R, e_c = self.m, self.R, self.e_c
         Gm = math.hypot(self.Gx, self.Gy)
         U = m * e_c * hi
-        cen = m * c_r * self.rho * self.rho
+        cen = self.cen
         rn_lo = cen * lo - Gm - self.akcr - U
         rn_hi = cen * hi + Gm + U
         Fo = Gm + U
@@ -341,8 +342,8 @@ class DryWhirl:
     def _zg_dot(self, u: float, path: tuple[float, ...]) -> complex:
         """The mass centre's velocity z_G' (m/s) at u from ``_path(u)``."""
         om2, th = path[3], path[4]
-        E = cmath.exp(1j * (self.psi0 + self.sig * u + self.phi))
-        return 1j * self.sig * math.sqrt(om2) * (self.e_c * E - self.R * cmath.exp(1j * th))
+        E = cmath.rect(1.0, self.psi0 + self.sig * u + self.phi)  # (cmath.exp(i x)'s values)
+        return 1j * self.sig * math.sqrt(om2) * (self.e_c * E - self.R * cmath.rect(1.0, th))
 
     def _end(self, panel: _DirectPanel | _LevinPanel, u: float, dur: float, work: int,
              step0: float) -> SegmentEnd:

@@ -134,8 +134,8 @@ class StepContext:
     never stored on the core: its work and work bound, the rounding error of its local
     time, and the flags that live for one step only. (Its impulses go to the StepReport.)"""
 
-    __slots__ = ("cap", "first", "held", "imb_whole", "n_slack", "roll_lenient",
-                 "rub_refused", "s_lo", "sticky_at", "work")
+    __slots__ = ("cap", "first", "held", "imb_whole", "n_slack", "orbit_asked",
+                 "roll_lenient", "rub_refused", "s_lo", "sticky_at", "work")
 
     def __init__(self, cap: int, rub_refused: bool = False) -> None:
         self.work = Work()
@@ -148,6 +148,8 @@ class StepContext:
         self.first = True  # in the step's first segment (the step loop clears it)
         self.imb_whole = False  # P_imb of the whole step in closed form (_advance_free)
         self.held: Any = None  # SpinCore: the step's held inputs (spin_contact.HeldInputs)
+        self.orbit_asked = False  # SpinCore: the dry whirl orbit refused the first
+        # segment already (SpinSteps._spin_roll_step), and the core holds its answer
 
     def later(self, s: float, ds: float) -> float:
         """Step-local time s + ds (s), its rounding error kept in s_lo (2Sum): a long step

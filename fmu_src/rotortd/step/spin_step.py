@@ -29,6 +29,7 @@ from ..contact.search import SEGMENT_WORK, WORK_MAX
 from ..contact.wall import SegmentEnd, WallForces
 from ..params import InputError, check_finite
 from ..scaled import TWO_PI_HI, TWO_PI_LO
+from ..segments import dry_whirl_orbit
 from ..segments.spin_contact import (
     ContactForces,
     ContactModel,
@@ -66,22 +67,52 @@ class SpinSteps:
                 and math.isfinite(F.real) and math.isfinite(F.imag)):
             self._reject_inputs(h, 0.0, F, amb_on)
             check_finite("T_drive", T_drive, InputError)
-        a = float(amb_on)
+        a, T = float(amb_on), float(T_drive)
         self._inputs = (self._inputs[0], F, a)
         cap = WORK_MAX if budget is None else max(0, min(budget, WORK_MAX))
         if self._mode == MODE_FREE and not self._on_wall:
-            rep = self._spin_quiet_step(h, F, a, float(T_drive), cap)
+            rep = self._spin_quiet_step(h, F, a, T, cap)
             if rep is not None:
                 return rep
-        held = HeldInputs(self._p, self._J, a, F, float(T_drive))
+        held = HeldInputs(self._p, self._J, a, F, T)
+        asked = (self._mode == MODE_ROLLING and self._race is None
+                 and SpinContact.orbit_applies(held, True))
+        if asked:
+            rep = self._spin_roll_step(h, held, cap)
+            if rep is not None:
+                return rep
         rep = StepReport()  # (then work_cap: a keyword argument costs 110 ns)
         rep.work_cap = cap
         t0, W0 = self._t, self._inputs[0]
         st = StepContext(cap)
         st.held = held
+        st.orbit_asked = asked
         s = self._segments(h, t0, rep, st)
         self._finish(rep, t0, s, h, True)
         self._spin_imbalance_torque(rep, W0, held.T_drive, h if s >= h else self._t - t0)
+        return rep
+
+    def _spin_roll_step(self, h: float, held: HeldInputs, cap: int) -> StepReport | None:
+        """A rolling step that the dry whirl orbit takes whole, without the step loop: the
+        loop's first segment (``_segments``, ``_spin_advance_contact``) asks the orbit
+        (``dry_whirl_orbit.advance``) with the same arguments, and the report is kept as
+        the loop keeps it for that one segment (``_end_segment``, ``_finish``, the spin's
+        balance): the same state and report to the bit. None where the orbit refuses; its
+        answer is then the core's orbit, and the loop's segment does not ask again
+        (``StepContext.orbit_asked``)."""
+        t0, W0 = self._t, self._inputs[0]
+        end, self._orbit = dry_whirl_orbit.advance(
+            self._orbit, held, self._theta, self._psi, W0, h, cap - SEGMENT_WORK,
+            self._slide_step)
+        if end is None:
+            return None
+        rep = StepReport()
+        rep.work_cap = cap
+        self._slide_step = end.next_step
+        self._end_segment(end, rep, None, 1.0 + 0j)
+        rep.work = SEGMENT_WORK + end.work
+        self._finish(rep, t0, h, h, True)
+        self._spin_imbalance_torque(rep, W0, held.T_drive, h)
         return rep
 
     def _spin_quiet_step(self, h: float, F: complex, a: float, T_drive: float, cap: int
@@ -306,7 +337,9 @@ class SpinSteps:
         slip = 0.0 if self._mode == MODE_ROLLING else self._slip
         seg = SpinContact(st.held, slip, self._theta, self._dtheta, self._psi,
                           self._inputs[0], self._slide_step,
-                          st.n_slack if s == st.sticky_at else 0.0, self._orbit)
+                          st.n_slack if s == st.sticky_at else 0.0, self._orbit,
+                          st.orbit_asked)
+        st.orbit_asked = False
         end = seg.run(rem, st.cap - st.work.total)
         st.work.iters += end.work
         self._slide_step = end.next_step
