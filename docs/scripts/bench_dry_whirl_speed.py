@@ -29,6 +29,9 @@ of the clearance), stepped by ``SpinCore.step`` at 1e-4 s. Per speed:
    integration (tests/reference/spin_mp.py), for ``orbit``, ``panels`` and ``old``: theta
    over (1 + its turn), psi over (1 + its turn), Omega relative, the impulses over
    max(|int N|, N_peak h) (as tests/test_dry_whirl_fast.py).
+3. The floor FMU's step (``bench_spin.floor_fmu_step``: FMPy's FMU2Slave loop, every output
+   read) and the ``orbit`` step at each speed (6000 rad/s included) over it: issue 26's
+   "rolling steps at most the floor's step" (``--floor-only`` adds it to the file).
 Writes docs/bench_dry_whirl_speed.json.
 """
 
@@ -161,6 +164,19 @@ def summary(ips: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
     return res
 
 
+def against_the_floor(orbit: dict[str, float]) -> dict[str, Any]:
+    """The floor FMU's step (``bench_spin.floor_fmu_step``) and each speed's rolling step on
+    the orbit (``orbit``: instructions per simulated second by speed) over it: issue 26's
+    "rolling steps at most the floor's step"."""
+    import bench_spin
+
+    floor = bench_spin.floor_fmu_step()
+    ratios = {w: v * H / floor for w, v in orbit.items()}
+    print(f"floor FMU step {floor / 1e3:.1f}k instructions; rolling step on the orbit over "
+          "it: " + ", ".join(f"{r:.3f} at {w} rad/s" for w, r in ratios.items()))
+    return {"floor_fmu_step": floor, "orbit_step_over_floor": ratios}
+
+
 def step_errors() -> dict[str, dict[str, dict[str, float]]]:
     """Errors of one 1e-4 s step against the 40-digit reference (module docstring, 2.)."""
     from rotortd.params import RotorParams
@@ -204,7 +220,15 @@ def main() -> int:
     ap.add_argument("--no-errors", action="store_true")
     ap.add_argument("--quick", nargs=2, metavar=("KINDS", "SPEEDS"),
                     help="count only these (comma-separated), print, write nothing")
+    ap.add_argument("--floor-only", action="store_true",
+                    help="only the floor FMU's step (3.), into the existing file, ~2 min")
     args = ap.parse_args()
+    if args.floor_only:
+        result = json.loads(OUT.read_text())
+        result.update(against_the_floor(result["instructions_per_simulated_s"]["orbit"]))
+        OUT.write_text(json.dumps(result, indent=1) + "\n")
+        print(f"wrote {OUT.relative_to(ROOT)}")
+        return 0
     if args.quick:
         count(tuple(float(w) for w in args.quick[1].split(",")),
               tuple(args.quick[0].split(",")))
@@ -214,6 +238,8 @@ def main() -> int:
     result: dict[str, Any] = {"instructions_per_simulated_s": ips, "summary": summary(ips),
                               "kernels_at_6000_rad_s": {k: v[f"{EXTRA:g}"]
                                                        for k, v in extra.items()}}
+    result.update(against_the_floor({**ips["orbit"], **{f"{EXTRA:g}": extra["orbit"][
+        f"{EXTRA:g}"]}}))
     if not args.no_errors:
         result["step_error_vs_40_digits"] = step_errors()
     OUT.write_text(json.dumps(result, indent=1) + "\n")

@@ -116,31 +116,44 @@ def quiet_fmu_steps() -> dict[str, Any]:
     step; each the difference of a 1100- and a 100-step run, in one run of this script."""
     out: dict[str, Any] = {}
     with tempfile.TemporaryDirectory() as tmp:
-        fmus = B.build_fmus(Path(tmp))
-        data: dict[str, Any] = {"h": H, "start": quiet_start_values(), "pi": QUIET_PI,
-                                "outputs": ([*B.REAL_OUT, "Omega_out"], B.INT_OUT,
-                                            B.BOOL_OUT)}
-        for key, name in (("fmu", "RotorTouchdown"), ("floor", "RotorTouchdownFloor")):
-            unzip, md = fmus[name]
-            data[key] = {"unzip": unzip, "guid": md.guid,
-                         "mid": md.coSimulation.modelIdentifier,
-                         "vr": {v.name: v.valueReference for v in md.modelVariables}}
-        pkl = Path(tmp) / "quiet.pkl"
-        pkl.write_bytes(pickle.dumps(data))
-        script = Path(tmp) / "fmu_child.py"
-        script.write_text(FMU_CHILD)
-        env = {**os.environ, **BI.SINGLE_THREAD}
-        for w in ("fmu", "floor"):  # a 0-step run first: the bytecode caches written, so
-            subprocess.run([sys.executable, str(script), str(pkl), w, "held", "0"],  # the
-                           env=env, check=True, capture_output=True)  # counted runs start alike
+        count = _fmu_child(Path(tmp), quiet_start_values())
         for drive in ("held", "pi"):
-            fmu, floor = (BI.per_unit(script, [str(pkl), w, drive], 100, 1100, env)
-                          for w in ("fmu", "floor"))
+            fmu, floor = (count(w, drive) for w in ("fmu", "floor"))
             out[drive] = {"fmu": fmu, "floor": floor, "ratio": fmu / floor, "goal": 1.5}
             print(f"quiet spin-state step, T_drive {drive:>4s}: RotorTouchdown "
                   f"{fmu / 1e3:7.1f}k, floor {floor / 1e3:7.1f}k instructions per FMU step, "
                   f"ratio {fmu / floor:.3f} (goal <= 1.5)", flush=True)
     return out
+
+
+def _fmu_child(tmp: Path, start: dict[str, Any]) -> Any:
+    """Build both FMUs into tmp and set up FMU_CHILD from ``start``; return
+    ``count(which, drive)``: instructions per FMU step of "fmu" or "floor" with T_drive
+    "held" or set by the "pi" drive (the difference of a 1100- and a 100-step run)."""
+    fmus = B.build_fmus(tmp)
+    data: dict[str, Any] = {"h": H, "start": start, "pi": QUIET_PI,
+                            "outputs": ([*B.REAL_OUT, "Omega_out"], B.INT_OUT, B.BOOL_OUT)}
+    for key, name in (("fmu", "RotorTouchdown"), ("floor", "RotorTouchdownFloor")):
+        unzip, md = fmus[name]
+        data[key] = {"unzip": unzip, "guid": md.guid, "mid": md.coSimulation.modelIdentifier,
+                     "vr": {v.name: v.valueReference for v in md.modelVariables}}
+    pkl = tmp / "child.pkl"
+    pkl.write_bytes(pickle.dumps(data))
+    script = tmp / "fmu_child.py"
+    script.write_text(FMU_CHILD)
+    env = {**os.environ, **BI.SINGLE_THREAD}
+    for w in ("fmu", "floor"):  # a 0-step run first: the bytecode caches written, so the
+        subprocess.run([sys.executable, str(script), str(pkl), w, "held", "0"],  # counted
+                       env=env, check=True, capture_output=True)  # runs start alike
+    return lambda which, drive: BI.per_unit(script, [str(pkl), which, drive], 100, 1100, env)
+
+
+def floor_fmu_step() -> float:
+    """Instructions per step of the floor FMU in FMU_CHILD's loop (every output read), from
+    the drop's start values: the floor's step that issue 26 compares a rolling step with
+    (``bench_dry_whirl_speed.py``)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        return _fmu_child(Path(tmp), drop_start_values())("floor", "held")
 
 
 def drop_start_values(omega0: float = OMEGA0) -> dict[str, Any]:
