@@ -29,9 +29,11 @@ of the clearance), stepped by ``SpinCore.step`` at 1e-4 s. Per speed:
    integration (tests/reference/spin_mp.py), for ``orbit``, ``panels`` and ``old``: theta
    over (1 + its turn), psi over (1 + its turn), Omega relative, the impulses over
    max(|int N|, N_peak h) (as tests/test_dry_whirl_fast.py).
-3. The floor FMU's step (``bench_spin.floor_fmu_step``: FMPy's FMU2Slave loop, every output
-   read) and the ``orbit`` step at each speed (6000 rad/s included) over it: issue 26's
-   "rolling steps at most the floor's step" (``--floor-only`` adds it to the file).
+3. The floor FMU's step (``bench_spin.rolling_fmu_steps``: FMPy's FMU2Slave loop, every
+   output read, the drop from 1000 rad/s over its steps 1500 to 2000) and the ``orbit`` step
+   at each speed (6000 rad/s included) over it: issue 26's "rolling steps at most the
+   floor's step"; RotorTouchdown's own step there, rolling at about 330 rad/s
+   (``--floor-only`` adds these to the file).
 Writes docs/bench_dry_whirl_speed.json.
 """
 
@@ -165,16 +167,20 @@ def summary(ips: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
 
 
 def against_the_floor(orbit: dict[str, float]) -> dict[str, Any]:
-    """The floor FMU's step (``bench_spin.floor_fmu_step``) and each speed's rolling step on
-    the orbit (``orbit``: instructions per simulated second by speed) over it: issue 26's
-    "rolling steps at most the floor's step"."""
+    """The floor FMU's step (``bench_spin.rolling_fmu_steps``) and each speed's rolling step
+    on the orbit (``orbit``: instructions per simulated second by speed) over it: issue 26's
+    "rolling steps at most the floor's step"; and RotorTouchdown's rolling step through
+    FMPy at those steps."""
     import bench_spin
 
-    floor = bench_spin.floor_fmu_step()
+    fmu, floor = bench_spin.rolling_fmu_steps()
     ratios = {w: v * H / floor for w, v in orbit.items()}
     print(f"floor FMU step {floor / 1e3:.1f}k instructions; rolling step on the orbit over "
           "it: " + ", ".join(f"{r:.3f} at {w} rad/s" for w, r in ratios.items()))
-    return {"floor_fmu_step": floor, "orbit_step_over_floor": ratios}
+    print(f"RotorTouchdown rolling through FMPy: {fmu / 1e3:.1f}k per step, "
+          f"{fmu / floor:.2f} of the floor's")
+    return {"floor_fmu_step": floor, "orbit_step_over_floor": ratios,
+            "fmu_rolling_step": fmu}
 
 
 def step_errors() -> dict[str, dict[str, dict[str, float]]]:

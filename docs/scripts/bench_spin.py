@@ -126,10 +126,11 @@ def quiet_fmu_steps() -> dict[str, Any]:
     return out
 
 
-def _fmu_child(tmp: Path, start: dict[str, Any]) -> Any:
+def _fmu_child(tmp: Path, start: dict[str, Any], steps: tuple[int, int] = (100, 1100)
+               ) -> Any:
     """Build both FMUs into tmp and set up FMU_CHILD from ``start``; return
     ``count(which, drive)``: instructions per FMU step of "fmu" or "floor" with T_drive
-    "held" or set by the "pi" drive (the difference of a 1100- and a 100-step run)."""
+    "held" or set by the "pi" drive (the difference of two runs of ``steps`` steps)."""
     fmus = B.build_fmus(tmp)
     data: dict[str, Any] = {"h": H, "start": start, "pi": QUIET_PI,
                             "outputs": ([*B.REAL_OUT, "Omega_out"], B.INT_OUT, B.BOOL_OUT)}
@@ -145,15 +146,17 @@ def _fmu_child(tmp: Path, start: dict[str, Any]) -> Any:
     for w in ("fmu", "floor"):  # a 0-step run first: the bytecode caches written, so the
         subprocess.run([sys.executable, str(script), str(pkl), w, "held", "0"],  # counted
                        env=env, check=True, capture_output=True)  # runs start alike
-    return lambda which, drive: BI.per_unit(script, [str(pkl), which, drive], 100, 1100, env)
+    return lambda which, drive: BI.per_unit(script, [str(pkl), which, drive], *steps, env)
 
 
-def floor_fmu_step() -> float:
-    """Instructions per step of the floor FMU in FMU_CHILD's loop (every output read), from
-    the drop's start values: the floor's step that issue 26 compares a rolling step with
-    (``bench_dry_whirl_speed.py``)."""
+def rolling_fmu_steps() -> tuple[float, float]:
+    """Instructions per FMU step in FMU_CHILD's loop (every output read) of RotorTouchdown
+    and of the floor FMU, in the drop from 1000 rad/s over its steps 1500 to 2000 (rolling
+    at about 330 rad/s): the floor's step that issue 26 compares a rolling step with, and
+    the FMU's (``bench_dry_whirl_speed.py``)."""
     with tempfile.TemporaryDirectory() as tmp:
-        return _fmu_child(Path(tmp), drop_start_values())("floor", "held")
+        count = _fmu_child(Path(tmp), drop_start_values(1000.0), (1500, 2000))
+        return count("fmu", "held"), count("floor", "held")
 
 
 def drop_start_values(omega0: float = OMEGA0) -> dict[str, Any]:
