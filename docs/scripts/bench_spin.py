@@ -382,7 +382,8 @@ def main() -> int:
                               plot_bearing_cost)
     if args.quiet_only:
         return _into_existing("quiet_fmu_step", quiet_fmu_steps, None)
-    result = {"timed": timed(args.repeats)}
+    result = json.loads(OUT.read_text()) if OUT.exists() else {}  # (the parts of the
+    result["timed"] = timed(args.repeats)  # flagged runs kept: --speeds, --bearing)
     if not args.no_valgrind:
         result["instructions_per_step"] = instructions()
         result["quiet_fmu_step"] = quiet_fmu_steps()
