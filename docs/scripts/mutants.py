@@ -132,8 +132,12 @@ MUTANTS: tuple[Mutant, ...] = (
       "RTOL = 1e-9\n\"\"\"Relative tolerance of the sliding integrator.\"\"\"",
       ("tests/test_contact.py",)),
     M("S4", "contact transitions", "sliding event located to 1e-9 of the time, not 1 ulp",
-      "lambda lo, hi, _: hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300,",
-      "lambda lo, hi, _: hi - lo <= 1e-9 * (abs(u) + hi) + 1e-300,", ("tests/test_contact.py",)),
+      "or hi - lo <= 2e-16 * (abs(u) + hi) + 1e-300,",
+      "or hi - lo <= 1e-9 * (abs(u) + hi) + 1e-300,", ("tests/test_contact.py",),
+      note="survives the quick group since the search also stops on the rounding band of "
+           "the event functions (seen[hi] >= -noise, added after this mutant was written): "
+           "no quick test has a sliding event whose search ends on the bracket's width; "
+           "not shown equivalent, not run against the slow group"),
     M("C1", "contact transitions", "lift-off tie-break at N = 0 inverted (leaves while N "
       "grows)", "return wf.gn_rate(self._theta, self._dtheta, E, dd) <= 0.0",
       "return wf.gn_rate(self._theta, self._dtheta, E, dd) >= 0.0",
@@ -237,8 +241,8 @@ MUTANTS: tuple[Mutant, ...] = (
       "(N = K delta^p (1 - chi delta'))", "N_law = N_el * (1.0 + self.cs.chi * dd)",
       "N_law = N_el * (1.0 - self.cs.chi * dd)", ("tests/test_real_bearing_core.py",)),
     M("B2", "real bearing: compliant law", "chi from the closing speed without the floor "
-      "(a slow closure undamped)", "chi = self._c_d / max(rdot, V_FLOOR)",
-      "chi = self._c_d / max(rdot, 1e-300)", ("tests/test_real_bearing_core.py",)),
+      "(a slow closure undamped)", "return c_d / max(v_onset, V_FLOOR)",
+      "return c_d / max(v_onset, 1e-300)", ("tests/test_real_bearing_core.py",)),
     M("B3", "real bearing: contact forces", "the contact's torque on the spin loses its lever "
       "B (the imbalance's)", "dOm = dOm0 - (B * N + A * Ft) * iJ",
       "dOm = dOm0 - (A * Ft) * iJ", ("tests/test_real_bearing_core.py",)),

@@ -10,7 +10,7 @@ the same step loop:
     drag law, also closed form)
     -> at the circle: under the rigid law the pair's impact law (contact.pair.ContactPair
        with the race as counter-body) and the low-speed rule; under the compliant law the
-       contact closes with chi = c_d/max(delta', V_FLOOR)
+       contact closes with chi = c_d/max(delta', V_FLOOR) (contact.laws.damping_factor)
     -> sustained contact (segments.bearing_contact.BearingContact: sliding or sticking,
        the race turning or held at rest, the compliant law clamped or not)
     -> separation or lift-off -> free flight.
@@ -29,7 +29,7 @@ from ..bodies.race import BearingParams, RealRace
 from ..bodies.rotor import RigidRotor, SpinReset
 from ..contact.events import Event
 from ..contact.impact import Impact
-from ..contact.laws import V_FLOOR, restitution_damping, stiffness_coefficient
+from ..contact.laws import damping_factor, restitution_damping, stiffness_coefficient
 from ..contact.pair import ContactPair
 from ..contact.wall import ContactTally, WallForces
 from ..segments.bearing_contact import (
@@ -150,7 +150,7 @@ class BearingSteps:
         if self._law.compliant:
             if not (rdot <= 0.0
                     and model.free_normal_acceleration(self._bearing_state()) <= 0.0):
-                self._bearing_enter(held, self._c_d / max(rdot, V_FLOOR))
+                self._bearing_enter(held, damping_factor(self._c_d, rdot))
         elif not rdot > 0.0 or self._bearing_impact(t, n, rdot, held, rep):
             self._bearing_enter(held, 0.0)
 
