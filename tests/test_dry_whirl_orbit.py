@@ -119,9 +119,10 @@ def test_grid_samples_are_the_forces_of_the_one_definition() -> None:
     assert worst <= 1e-13, worst
 
 
-def _rolling_core(W: float, **kw: float) -> SpinCore:
-    """The chapter's rotor (gravity, J = m R^2/2) rolling at the bottom of the clearance."""
-    p = RotorParams(**CHAPTER)
+def _rolling_core(W: float, params: dict[str, float] | None = None, **kw: float) -> SpinCore:
+    """The chapter's rotor (gravity, J = m R^2/2; ``params`` in place of CHAPTER) rolling at
+    the bottom of the clearance."""
+    p = RotorParams(**(CHAPTER if params is None else params))
     core = SpinCore(p, J, Omega0=W)
     th, dth = -math.pi / 2, -p.R * W / p.c_r
     n = cmath.exp(1j * th)
@@ -178,12 +179,7 @@ def test_a_rolling_step_asks_the_orbit_once(monkeypatch: pytest.MonkeyPatch) -> 
     runs = []
     for follow in (True, False):
         monkeypatch.setattr(SpinContact, "follow_orbit", follow)
-        p = RotorParams(**wobbly)
-        core = SpinCore(p, J, Omega0=2000.0)
-        th, dth = -math.pi / 2, -p.R * 2000.0 / p.c_r
-        n = cmath.exp(1j * th)
-        core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0,
-                               z=p.c_r * n, v=1j * p.c_r * dth * n))
+        core = _rolling_core(2000.0, wobbly)
         answers.clear()
         runs.append([core.step(H, amb_on=0.0).work for _ in range(3)] + [core.get_state()])
         assert core.mode == 2

@@ -52,7 +52,7 @@ GROUPS: dict[str, tuple[str, ...]] = {
         "segments/spin_flight.py::_run_quiet", "segments/spin_flight.py::short_taylor",
         "step/spin_step.py::_spin_quiet_step", "segments/spin_quiet.py",
         "step/spin_step.py::_spin_quiet_lane", "step/spin_step.py::SpinQuietLane",
-        "step/spin_step.py::make_spin_quiet_lane", "step/spin_step.py::_quiet_report",
+        "step/spin_step.py::make_spin_quiet_lane", "step/spin_step.py::_whole_report",
         "step/spin_step.py::_spin_roll_step"),
     "the held spin's declared accelerators (docs/architecture.md)": (
         "segments/flight.py", "segments/rolling.py", "segments/rub.py",

@@ -100,20 +100,14 @@ class SpinSteps:
         balance): the same state and report to the bit. None where the orbit refuses; its
         answer is then the core's orbit, and the loop's segment does not ask again
         (``StepContext.orbit_asked``)."""
-        t0, W0 = self._t, self._inputs[0]
+        W0 = self._inputs[0]
         end, self._orbit = dry_whirl_orbit.advance(
             self._orbit, held, self._theta, self._psi, W0, h, cap - SEGMENT_WORK,
             self._slide_step)
         if end is None:
             return None
-        rep = StepReport()
-        rep.work_cap = cap
         self._slide_step = end.next_step
-        self._end_segment(end, rep, None, 1.0 + 0j)
-        rep.work = SEGMENT_WORK + end.work
-        self._finish(rep, t0, h, h, True)
-        self._spin_imbalance_torque(rep, W0, held.T_drive, h)
-        return rep
+        return self._whole_report(h, W0, held.T_drive, cap, end.work, end)
 
     def _spin_quiet_step(self, h: float, F: complex, a: float, T_drive: float, cap: int
                          ) -> StepReport | None:
@@ -137,7 +131,7 @@ class SpinSteps:
                 self._z, self._v = end[0], end[1]
                 self._set_psi(end[2])
                 self._set_spin(end[3])
-                return self._quiet_report(h, W0, T_drive, cap, QUIET_WORK)
+                return self._whole_report(h, W0, T_drive, cap, QUIET_WORK)
         if h * abs(W0) > HORIZON:
             return None  # longer than one bound covers (the horizon is <= HORIZON/|W0|)
         fl = SpinFlight(p, self._J, a, F, T_drive, z, v, self._psi, W0)
@@ -149,13 +143,17 @@ class SpinSteps:
             return None
         self._z, self._v = end.z, end.v
         self._spin_advance_spin(end)
-        return self._quiet_report(h, W0, T_drive, cap, end.work)
+        return self._whole_report(h, W0, T_drive, cap, end.work)
 
-    def _quiet_report(self, h: float, W0: float, T_drive: float, cap: int, work: int
-                      ) -> StepReport:
-        """The report of a quiet step that took ``work`` units, the clock advanced by h."""
+    def _whole_report(self, h: float, W0: float, T_drive: float, cap: int, work: int,
+                      end: SegmentEnd | None = None) -> StepReport:
+        """The report of a step taken whole as the step loop's one segment (a quiet step,
+        or ``end``, a contact segment's, applied first), which took ``work`` units; the
+        clock advanced by h."""
         rep = StepReport()
         rep.work_cap = cap
+        if end is not None:
+            self._end_segment(end, rep, None, 1.0 + 0j)
         rep.work = SEGMENT_WORK + work
         self._finish(rep, self._t, h, h, True)
         self._spin_imbalance_torque(rep, W0, T_drive, h)
@@ -375,7 +373,7 @@ class SpinQuietLane(Protocol):
 def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
     """The spin state's quiet lane for the inputs and step of ``q``, from times within
     t_tol (s) of the core's: ``lane(core, t, h, T_drive)`` takes ``_spin_quiet_step``'s
-    first branch (``q.clear``, ``q.step``) and the step's end as ``_quiet_report`` does
+    first branch (``q.clear``, ``q.step``) and the step's end as ``_whole_report`` does
     (``_set_psi``, the spin, the compensated clock of ``_finish``, T_imb of
     ``_spin_imbalance_torque`` with P_t = 0), then ``output_values()`` in flight, inlined
     as the held lane inlines them (``flight_step.make_quiet_lane``): the same operations
