@@ -20,13 +20,18 @@ of the clearance), stepped by ``SpinCore.step`` at 1e-4 s. Per speed:
    - ``levin``: the panels with the Fourier-Levin panel at every speed (BETA_DIRECT < 0);
    - ``old``: the bearing off, the accelerators off (``SpinContact.accelerate = False``:
      the extrapolation integrator, at most one radian of beta per step);
+   - ``driven``: ``orbit`` with T_drive = T_DRIVE (1 N m) held (``dry_whirl_driven``: the
+     orbit's Fourier form with the level as a variable, a table per band of levels);
+   - ``driven_panels``: the same with ``SpinContact.follow_orbit`` False (the panels, what
+     a held drive torque took before);
    - ``damper``: the bearing on (amb_on = 1, c = 1400 N s/m: the energy integral does not
      hold, the integrator runs), for the cost law of that path.
    Printed with the ratio max/min over the speeds (the issue's target: at most 1.5 between
    60 and 2000 rad/s) and the exponent of a power law through the first and last speed;
-   ``orbit``, ``panels`` and ``levin`` also at 6000 rad/s (not in the ratio).
+   the kernels (``KERNELS``) also at 6000 rad/s (not in the ratio).
 2. The error of one 1e-4 s step from (theta, psi) = (-1.3, 0.4) against the 40-digit Taylor
-   integration (tests/reference/spin_mp.py), for ``orbit``, ``panels`` and ``old``: theta
+   integration (tests/reference/spin_mp.py), for ``orbit``, ``panels``, ``old`` and
+   ``driven`` (with its T_drive; ``driven_panels`` as ``panels`` with it): theta
    over (1 + its turn), psi over (1 + its turn), Omega relative, the impulses over
    max(|int N|, N_peak h) (as tests/test_dry_whirl_fast.py).
 3. The floor FMU's step (``bench_spin.rolling_fmu_steps``: FMPy's FMU2Slave loop, every
@@ -59,8 +64,10 @@ OUT = ROOT / "docs" / "bench_dry_whirl_speed.json"
 SPEEDS = (60.0, 200.0, 600.0, 2000.0)
 EXTRA = 6000.0
 """A further speed for the kernels alone (KERNELS): where their cost stays."""
-KINDS = ("orbit", "panels", "levin", "old", "damper")
-KERNELS = ("orbit", "panels", "levin")
+KINDS = ("orbit", "panels", "levin", "old", "damper", "driven", "driven_panels")
+KERNELS = ("orbit", "panels", "levin", "driven", "driven_panels")
+T_DRIVE = 1.0
+"""The drive torque (N m) of the ``driven`` kinds."""
 H, WARM, N_SHORT, N_LONG = 1e-4, 5, 10, 60
 
 CHILD = '''
@@ -72,8 +79,10 @@ from rotortd.segments import rolling_spin_fast, spin_contact
 kind, W, n = sys.argv[2], float(sys.argv[3]), int(sys.argv[4])
 p = RotorParams(g=9.81)
 J = 0.5 * p.m * p.R ** 2
-spin_contact.SpinContact.accelerate = kind in ("orbit", "panels", "levin")
-spin_contact.SpinContact.follow_orbit = kind == "orbit"
+spin_contact.SpinContact.accelerate = kind in ("orbit", "panels", "levin", "driven",
+                                               "driven_panels")
+spin_contact.SpinContact.follow_orbit = kind in ("orbit", "driven")
+T = TDRIVE if kind.startswith("driven") else 0.0
 if kind == "levin":
     rolling_spin_fast.BETA_DIRECT = -1.0
 core = SpinCore(p, J, Omega0=W)
@@ -83,9 +92,9 @@ core.set_state(replace(core.state, mode=2, theta=th, dtheta=dth, slip=0.0, z=p.c
                        v=1j * p.c_r * dth * nn))
 a = 1.0 if kind == "damper" else 0.0
 for _ in range(WARM + n):
-    core.step(H, amb_on=a)
+    core.step(H, amb_on=a, T_drive=T)
 assert core.mode == 2, (kind, W, core.mode)
-'''.replace("WARM", str(WARM)).replace("H,", f"{H!r},")
+'''.replace("WARM", str(WARM)).replace("H,", f"{H!r},").replace("TDRIVE", repr(T_DRIVE))
 
 
 def sanity(W: float, kind: str) -> tuple[int, int]:
@@ -95,15 +104,23 @@ def sanity(W: float, kind: str) -> tuple[int, int]:
     from dataclasses import replace
 
     from rotortd import RotorParams, SpinCore
-    from rotortd.segments import dry_whirl_orbit, rolling_spin_fast, spin_contact
+    from rotortd.segments import (
+        dry_whirl_driven,
+        dry_whirl_orbit,
+        rolling_spin_fast,
+        spin_contact,
+    )
 
     used = declined = 0
     orig_orbit, orig_panel = dry_whirl_orbit.advance, rolling_spin_fast.DryWhirl.advance
+    orig_driven = dry_whirl_driven.advance
+    on_orbit = kind in ("orbit", "driven")
+    orig = {"orbit": orig_orbit, "driven": orig_driven}.get(kind, orig_panel)
 
     def counted(*a: Any, **k: Any) -> Any:
         nonlocal used, declined
-        out = (orig_orbit if kind == "orbit" else orig_panel)(*a, **k)
-        end = out[0] if kind == "orbit" else out
+        out = orig(*a, **k)
+        end = out[0] if on_orbit else out
         used += end is not None
         declined += end is None
         return out
@@ -117,17 +134,20 @@ def sanity(W: float, kind: str) -> tuple[int, int]:
     keep = rolling_spin_fast.BETA_DIRECT
     if kind == "orbit":
         dry_whirl_orbit.advance = counted
+    elif kind == "driven":
+        dry_whirl_driven.advance = counted
     else:
         rolling_spin_fast.DryWhirl.advance = counted  # type: ignore[method-assign]
     spin_contact.SpinContact.accelerate = True
-    spin_contact.SpinContact.follow_orbit = kind == "orbit"
+    spin_contact.SpinContact.follow_orbit = on_orbit
     try:
         if kind == "levin":
             rolling_spin_fast.BETA_DIRECT = -1.0
         for _ in range(5):
-            core.step(H, amb_on=0.0)
+            core.step(H, amb_on=0.0, T_drive=T_DRIVE if kind.startswith("driven") else 0.0)
     finally:
         dry_whirl_orbit.advance = orig_orbit
+        dry_whirl_driven.advance = orig_driven
         rolling_spin_fast.DryWhirl.advance = orig_panel  # type: ignore[method-assign]
         rolling_spin_fast.BETA_DIRECT = keep
         spin_contact.SpinContact.follow_orbit = True
@@ -196,13 +216,17 @@ def step_errors() -> dict[str, dict[str, dict[str, float]]]:
                                       "g", "levitate")}
     J, th0, psi0 = 0.5 * p.m * p.R ** 2, -1.3, 0.4
     mc = p.m * p.c_r
-    out: dict[str, dict[str, dict[str, float]]] = {"orbit": {}, "panels": {}, "old": {}}
+    out: dict[str, dict[str, dict[str, float]]] = {
+        "orbit": {}, "panels": {}, "old": {}, "driven": {}, "driven_panels": {}}
     for W in SPEEDS:
-        ref = mp_contact(par, J, 0, th0, 0.0, psi0, W, H, a=0.0)
+        refs = {T: mp_contact(par, J, 0, th0, 0.0, psi0, W, H, a=0.0, T_drive=T)
+                for T in (0.0, T_DRIVE)}
         for kind in out:
-            seg = SpinContact(HeldInputs(p, J, 0.0, 0j, 0.0), 0.0, th0, 0.0, psi0, W)
+            T = T_DRIVE if kind.startswith("driven") else 0.0
+            ref = refs[T]
+            seg = SpinContact(HeldInputs(p, J, 0.0, 0j, T), 0.0, th0, 0.0, psi0, W)
             seg.accelerate = kind != "old"
-            seg.follow_orbit = kind == "orbit"
+            seg.follow_orbit = kind in ("orbit", "driven")
             end = seg.run(H, 10 ** 9)
             tal = end.tally
             assert tal is not None

@@ -510,17 +510,28 @@ def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: i
     """The end of rem (s) of rolling on ``orb`` from (theta, psi) (``w``: its physics, with
     K0 from the orbit's energy) that travels u rad of psi with the periodic parts of the
     impulses of ``solved`` (``_solve`` or the orbit's ``StepMap``)."""
-    sig, rho1 = w.sig, 1.0 + w.rho
     x, P, int_n = solved
     u = rem / orb.f00 + x
     P += orb.d00 * u
     int_n = orb.n_sec * u + int_n if w.akcr else 0j
+    return segment_end(w, psi, rem, u, P, int_n, orb.peak_on, work, step0, orb)
+
+
+def segment_end(w: DryWhirl, psi: float, rem: float, u: float, P: complex, int_n: complex,
+                peak_on: Any, work: int, step0: float, orb: Any) -> SegmentEnd:
+    """The end of rem (s) of rolling from ``w``'s start (psi (rad)) that travels u rad of
+    psi with the impulses P = int (N + i F_t) dt (N s) and int n dt (s): the path at both
+    ends, the contact impulse from the momentum balance, the peak N (at the ends and, where
+    beta turns through every phase, ``peak_on(psi_a, psi_b)`` over the rows of a grid, else
+    at the middle), the tally; ``orb`` is kept for the next step (``Orbit`` or
+    ``dry_whirl_driven.LevelTable``)."""
+    sig, rho1 = w.sig, 1.0 + w.rho
     start, end = w._path(0.0), w._path(u)
     Pc = w.contact_impulse(u, rem, int_n, (start, end))
     _, N, _, om2, th = end
     peak = max(abs(N), abs(start[1]))
     if u * rho1 >= 2.0 * math.pi:  # beta has turned through every phase
-        peak = max(peak, orb.peak_on(psi, psi + sig * u))
+        peak = max(peak, peak_on(psi, psi + sig * u))
     else:
         peak = max(peak, abs(w._path(0.5 * u)[1]))
     Om = sig * math.sqrt(om2)

@@ -39,7 +39,7 @@ from ..contact.events import LIFT_OFF, SLIP_START, SLIP_ZERO
 from ..contact.search import WORK_MAX
 from ..contact.wall import ContactTally, ContactWorkExceeded, SegmentEnd
 from ..params import RotorParams
-from . import dry_whirl_orbit, gbs, rolling_spin_fast
+from . import dry_whirl_driven, dry_whirl_orbit, gbs, rolling_spin_fast
 from .gbs import RHS_WORK, STEP_WORK
 from .roots import ROOT_ITERS, illinois
 
@@ -162,6 +162,21 @@ def rolling_forces(h: HeldInputs, theta: float, psi: float, Omega: float) -> Con
     return ContactForces(*ContactModel(h).rolling(theta, psi, Omega)[:4])
 
 
+OrbitLike = dry_whirl_orbit.Orbit | dry_whirl_driven.LevelTable | None
+"""What rolling keeps from step to step: the orbit (T_drive = 0) or the level table (T_drive
+held) of its last step, if any."""
+
+
+def orbit_advance(prev: OrbitLike, h: HeldInputs, theta: float, psi: float, Omega: float,
+                  rem: float, limit: int, step0: float
+                  ) -> tuple[SegmentEnd | None, OrbitLike]:
+    """Roll rem (s) on the orbit's Fourier form: ``dry_whirl_orbit.advance`` without drive
+    torque, ``dry_whirl_driven.advance`` with one held (the same arguments and answer)."""
+    if h.T_drive == 0.0:
+        return dry_whirl_orbit.advance(prev, h, theta, psi, Omega, rem, limit, step0)
+    return dry_whirl_driven.advance(prev, h, theta, psi, Omega, rem, limit, step0)
+
+
 class SpinContact:
     """One contact segment, sliding (s = +-1) or rolling (s = 0), from
     (theta, theta', psi, Omega); in rolling theta' = -R Omega/c_r is implied."""
@@ -171,13 +186,15 @@ class SpinContact:
     its energy integral (``rolling_spin_fast.DryWhirl``, docs/notes/dry-whirl-quadrature.md)
     where that applies and no event can occur; False: always the integrator below."""
     follow_orbit = True
-    """Declared accelerator: with T_drive = 0 as well, rolling is advanced on its orbit
-    (``dry_whirl_orbit``: the 2-D Fourier form of the energy integral, kept across steps;
-    docs/notes/dry-whirl-quadrature.md §8); False: the panels of ``DryWhirl`` instead."""
+    """Declared accelerator: rolling is advanced on its orbit, the 2-D Fourier form of the
+    energy integral kept across steps (``dry_whirl_orbit`` with T_drive = 0,
+    docs/notes/dry-whirl-quadrature.md §8; ``dry_whirl_driven`` with T_drive held, its
+    coefficients as functions of the level, §10); False: the panels of ``DryWhirl``
+    instead."""
 
     def __init__(self, h: HeldInputs, s: float, theta: float, dtheta: float, psi: float,
                  Omega: float, step0: float = math.inf, n_slack: float = 0.0,
-                 orbit: dry_whirl_orbit.Orbit | None = None, asked: bool = False) -> None:
+                 orbit: OrbitLike = None, asked: bool = False) -> None:
         self.h, self.s = h, s
         self.orbit = orbit  # rolling: the dry whirl orbit of the previous step, if any
         self.asked = asked  # the orbit refused this segment already, and ``orbit`` is its
@@ -197,10 +214,10 @@ class SpinContact:
 
     @classmethod
     def orbit_applies(cls, h: HeldInputs, rolling: bool) -> bool:
-        """The orbit (``dry_whirl_orbit``) is tried first: rolling, the accelerators on,
-        a c = 0 and T_drive = 0."""
+        """The orbit (``orbit_advance``) is tried first: rolling, the accelerators on and
+        a c = 0."""
         return (rolling and cls.accelerate and cls.follow_orbit
-                and h.T_drive == 0.0 and rolling_spin_fast.applies(h))
+                and rolling_spin_fast.applies(h))
 
     def _setup(self) -> None:
         """The contact model, the integrator's step bounds and tolerances (not built where
@@ -264,8 +281,8 @@ class SpinContact:
         # (docs/notes/dry-whirl-quadrature.md; as set on the class at construction and on
         # the instance now); None = not here
         if self._on_orbit and self.accelerate and self.follow_orbit:
-            fast, orbit = dry_whirl_orbit.advance(self.orbit, self.h, *self.y0, rem, limit,
-                                                  self.step0)
+            fast, orbit = orbit_advance(self.orbit, self.h, *self.y0, rem, limit,
+                                        self.step0)
             if fast is not None:
                 return fast
         if not self._ready:

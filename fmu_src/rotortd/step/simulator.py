@@ -37,6 +37,7 @@ from ..segments.bearing_contact import ContactState
 from ..segments.dry_whirl_orbit import Orbit, orbit_key
 from ..segments.flight import FlightModel
 from ..segments.rub import RubEquilibrium
+from ..segments.spin_contact import OrbitLike
 from ..segments.spin_quiet import QuietSpinStep
 from .bearing_step import BearingSteps
 from .contact_step import LOCK_TOL, RUB_RETRY, ContactSteps
@@ -135,7 +136,8 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         self._E_diss = 0.0
         self._t_contact = math.nan
         self._slide_step = math.inf
-        self._orbit: Orbit | None = None  # rolling with the spin a state: its dry whirl orbit
+        self._orbit: OrbitLike = None  # rolling with the spin a state: its dry whirl orbit
+        # (or level table, ``dry_whirl_driven``: not part of the state, a function of it)
         self._quiet_spin: QuietSpinStep | None = None  # the spin state's quiet step (a cache)
         self.imbalance_torque = True
         """Compute the imbalance reaction torque (StepReport.P_imb, T_imb) with the spin
@@ -621,9 +623,9 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
             slip=self._slip, locked=self._locked, on_wall=self._on_wall,
             n_impacts=self._n_impacts, t_last=self._t_last, v_last=self._v_last,
             E_diss=self._E_diss, t_contact=self._t_contact, slide_step=self._slide_step,
-            orbit_energy=(self._orbit.E if self._orbit is not None
+            orbit_energy=(self._orbit.E if isinstance(self._orbit, Orbit)
                           and self._mode == MODE_ROLLING else math.nan),
-            orbit_step=(self._orbit.last_rem if self._orbit is not None
+            orbit_step=(self._orbit.last_rem if isinstance(self._orbit, Orbit)
                         and self._mode == MODE_ROLLING else math.nan),
             imb_h=(self._imb_seen_h, self._imb_free_h),
             Omega=self._inputs[0], F_ext=self._inputs[1], amb_on=self._inputs[2],

@@ -29,12 +29,12 @@ from ..contact.search import SEGMENT_WORK, WORK_MAX
 from ..contact.wall import SegmentEnd, WallForces
 from ..params import InputError, check_finite
 from ..scaled import TWO_PI_HI, TWO_PI_LO
-from ..segments import dry_whirl_orbit
 from ..segments.spin_contact import (
     ContactForces,
     ContactModel,
     HeldInputs,
     SpinContact,
+    orbit_advance,
     rolling_forces,
     sliding_forces,
 )
@@ -95,13 +95,13 @@ class SpinSteps:
     def _spin_roll_step(self, h: float, held: HeldInputs, cap: int) -> StepReport | None:
         """A rolling step that the dry whirl orbit takes whole, without the step loop: the
         loop's first segment (``_segments``, ``_spin_advance_contact``) asks the orbit
-        (``dry_whirl_orbit.advance``) with the same arguments, and the report is kept as
+        (``orbit_advance``) with the same arguments, and the report is kept as
         the loop keeps it for that one segment (``_end_segment``, ``_finish``, the spin's
         balance): the same state and report to the bit. None where the orbit refuses; its
         answer is then the core's orbit, and the loop's segment does not ask again
         (``StepContext.orbit_asked``)."""
         W0 = self._inputs[0]
-        end, self._orbit = dry_whirl_orbit.advance(
+        end, self._orbit = orbit_advance(
             self._orbit, held, self._theta, self._psi, W0, h, cap - SEGMENT_WORK,
             self._slide_step)
         if end is None:

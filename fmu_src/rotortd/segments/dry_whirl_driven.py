@@ -1,0 +1,515 @@
+"""Dry whirl with a held drive torque: the orbit's Fourier form with the level as a variable
+(docs/notes/dry-whirl-quadrature.md §10).
+
+Frame and units: inertial, SI, as ``dry_whirl_orbit`` (whose grid and sums this module
+uses) and ``rolling_spin_fast`` (whose physics, ``DryWhirl``, it uses). With T_drive held
+the energy integral of rolling on the fixed race (a c = 0) reads
+
+    I_P(beta) Omega^2 = K - 2 V_p(beta, psi),   K = K_s + 2 T_drive sigma u   (J),
+
+V_p = -c_r Re(conj(G) n) + m g e_c sin(psi + phi) the periodic part of the potential,
+K_s = I_P Omega^2 + 2 V_p at the step's start and u >= 0 the spin angle travelled. The level
+K moves with u; the integrands are explicit functions of it (x = 2 V_p/K, |x| <= eps):
+
+    F = 1/|Omega| = sqrt(I_P) K^(-1/2) (1 - x)^(-1/2) = sum_k [sqrt(I_P) b_k (2 V_p)^k] K^(-1/2-k),
+    1/F = sum_k [b'_k (2 V_p)^k / sqrt(I_P)] K^(1/2-k),
+    D = (N + i F_t) F = Q0 F + Q1/F,
+
+(b_k, b'_k the binomial series of (1 - x)^(-1/2) and (1 - x)^(1/2); N + i F_t = Q0 + Q1
+Omega^2, the rolling forces being linear in Omega^2). So every harmonic of F and D on the
+torus (beta, psi) is c_jl(K) = sum_k a_jlk K^(p0 - k), with a table a_jlk fixed by the rotor
+and the held inputs (``LevelTable``: 2-D DFTs on the orbit's grid, once per band of levels).
+Within a step K = K_s (1 + delta s), delta = 2 T sigma/K_s, and
+
+    c_jl(s) = sum_n c_jl^n s^n,   c_jl^n = delta^n sum_k a_jlk K_s^(p0-k) C(p0 - k, n),
+
+so each harmonic is a polynomial in s times e^{i phi_jl(s)}, integrated in closed form
+(int_0^u P(s) e^{i omega s} ds = [Y(s) e^{i omega s}]_0^u, Y' + i omega Y = P, the backward
+recurrence of the Levin panel: omega = sigma w_jl, |w_jl| >= 1, and delta u <= 1e-2, so it
+does not amplify). Most harmonics need only n = 0; orders n >= 1 are kept for the largest
+harmonics while the rest integrate to within a share of the tolerance (``_orders``). A step
+is then Newton on these sums (as ``dry_whirl_orbit._solve``) and the impulse sums at both
+ends: its work follows the number of harmonics, which falls with the speed (eps = 2 V_b/K).
+
+Errors (estimated, as ``dry_whirl_orbit``): the check harmonics (+-(K + 1)), the table terms
+left out (smallest first, TRIM_SHARE of the tolerance) and the orders k beyond the table's (the
+binomial tail, bounded by eps^(k+1)/(1 - eps)), each at its largest over the band, within
+LEVEL_SHARE of the step's tolerance; the orders n left out within ORDER_SHARE. Events:
+``DryWhirl._no_event`` over the whole torus and every Omega^2 the band allows, once per
+table. Where anything fails (the band's eps too large, an event not excluded, the step
+leaving the band, the bearing's spring on: a k != 0) ``advance`` declines and the panels of
+``rolling_spin_fast`` take the step.
+
+The table is a function of the held inputs and the band of K_s alone (bands of BAND_LOG2 in
+log2 K), never of the history: a restored state rebuilds the same table and continues bit for
+bit; its build is not charged as work (it is bounded, TABLE_WORK, and taken only where the
+step's work limit covers it), so that the work counts are the state's alone.
+"""
+
+from __future__ import annotations
+
+import bisect
+import cmath
+import math
+from operator import mul
+from typing import TYPE_CHECKING, Any
+
+from .dry_whirl_orbit import (
+    _CB,
+    _SB,
+    DELTA_MAX,
+    K_BETA,
+    K_PSI,
+    N_BETA,
+    N_PSI,
+    NEWTON_ITERS,
+    RHO_MIN,
+    Key,
+    Row,
+    _dft2,
+    _i_min,
+    _series,
+    _v_bound,
+    segment_end,
+)
+from .rolling_spin_fast import SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
+
+if TYPE_CHECKING:
+    from ..contact.wall import SegmentEnd
+    from .spin_contact import HeldInputs
+
+BAND_LOG2 = 0.25
+"""Width of a band of levels K in log2 K: the table of band b serves K_s in
+[2^(b BAND_LOG2), 2^((b + 1) BAND_LOG2)), widened by WIDEN each way for the step's end."""
+WIDEN = 1.02
+"""The band's table holds from its lower edge / WIDEN to its upper edge * WIDEN."""
+EPS_MAX = 0.02
+"""Largest 2 V_b/K over the band (V_b = c_r |G| + m g e_c) for which a table is built: the
+expansion in x = 2 V_p/K then needs at most K_ORDERS orders."""
+K_ORDERS = 12
+"""Most orders k of the table (the binomial tail eps^(k+1)/(1 - eps) at most LEVEL_TAIL)."""
+LEVEL_TAIL = 1e-17
+"""The binomial tail left out of the table, relative to the integrand's mean."""
+TRIM_SHARE = 0.3
+"""The table's terms left out, smallest first, sum to at most this share of the tolerance
+per radian of psi (TOL_PHASE of the mean of F, TOL_IMPULSE of the mean of D)."""
+LEVEL_SHARE = 0.9
+"""The share of the step's tolerance that the table's left-out parts may take."""
+ORDER_SHARE = 0.01
+"""The share of the step's tolerance that the orders n of each degree left out may take
+(at most N_ORDERS degrees: 1 - LEVEL_SHARE in all)."""
+N_ORDERS = 10
+"""Most degrees n of the polynomials in s (the relative change of K over a step,
+|delta| u, is then at most ORDER_DELTA)."""
+ORDER_DELTA = 0.01
+"""Largest relative change of the level over a step taken here."""
+TABLE_WORK = SAMPLE_WORK * N_BETA * N_PSI * 4
+"""The most work (units) a table's build takes (two samples of the forces at each grid
+point and the DFTs); it is built only where the step's work limit covers this."""
+STEP_WORK = SAMPLE_WORK * (2 * NEWTON_ITERS + 5)
+"""The work (units) charged for a step (as ``dry_whirl_orbit``'s)."""
+
+Harmonic = tuple[int, int, int, list[complex], complex]
+"""One harmonic of a table: (j, l, k_lo, the coefficients a_jlk/(i sigma w_jl) from order
+k_lo on, 1/(i sigma w_jl))."""
+
+
+def _binomials(p0: float, k_max: int) -> list[list[float]]:
+    """C(p0 - k, n) for k = 0..k_max, n = 0..N_ORDERS (generalised binomials)."""
+    out = []
+    for k in range(k_max + 1):
+        row, c = [], 1.0
+        for n in range(N_ORDERS + 1):
+            row.append(c)
+            c *= (p0 - k - n) / (n + 1)
+        out.append(row)
+    return out
+
+
+def _series_b(inverse: bool, k_max: int) -> list[float]:
+    """The coefficients of (1 - x)^(-1/2) (inverse False) or (1 - x)^(1/2) (True) to
+    x^k_max."""
+    p = 0.5 if inverse else -0.5
+    out, c = [], 1.0
+    for k in range(k_max + 1):
+        out.append(c)
+        c *= -(p - k) / (k + 1)
+    return out
+
+
+def band_of(K: float) -> int:
+    """The band of the level K (J): floor(log2 K / BAND_LOG2)."""
+    return math.floor(math.log2(K) / BAND_LOG2)
+
+
+def level_key(h: HeldInputs, Omega: float) -> Key:
+    """What a table depends on besides the band: the rotor, the held inputs and the spin's
+    direction."""
+    return (h.p, h.J, h.a, h.F_ext, h.T_drive, Omega >= 0.0)
+
+
+class LevelTable:
+    """The table a_jlk of F and D (module docstring) for ``key`` and the band ``band`` of
+    levels; ``ok`` False where it cannot serve (eps too large, an event not excluded, the
+    series do not converge within the tolerance)."""
+
+    __slots__ = ("D", "D00", "F", "F00", "K_hi", "K_lo", "band", "bd", "bf", "d00_min",
+                 "d_scale", "err_d", "err_t", "k_max", "kappa", "key", "mean_d", "mean_f",
+                 "n_rows", "ok", "suf_d", "suf_f", "w_max", "w_min")
+
+    def __init__(self, w: DryWhirl, key: Key, band: int) -> None:
+        self.key, self.band, self.ok = key, band, False
+        self.K_lo = 2.0 ** (band * BAND_LOG2) / WIDEN
+        self.K_hi = 2.0 ** ((band + 1) * BAND_LOG2) * WIDEN
+        vb = _v_bound(w)
+        eps = 2.0 * vb / self.K_lo
+        if not (eps <= EPS_MAX and w.c2 <= DELTA_MAX * w.I0 and w.akcr == 0.0):
+            return
+        i_max, i_min = w.J + w.m * (w.R + w.e_c) ** 2, _i_min(w)
+        lo, hi = (self.K_lo - 2.0 * vb) / i_max, (self.K_hi + 2.0 * vb) / i_min
+        if not (lo > 0.0 and w._no_event(lo, hi)):
+            return
+        self.w_min, self.w_max = math.sqrt(lo), math.sqrt(hi)
+        tail, k_max = math.sqrt(i_max * hi / (i_min * lo)) * eps / (1.0 - eps), 0
+        while tail > LEVEL_TAIL and k_max < K_ORDERS:
+            tail *= eps
+            k_max += 1
+        if tail > LEVEL_TAIL:
+            return
+        self.k_max = k_max
+        fs, ds = self._grid(w, k_max)
+        self.bf, self.bd = _binomials(-0.5, k_max), _binomials(0.5, k_max + 1)
+        self._tables(w, [_dft2(x) for x in fs], [_dft2(x) for x in ds], tail)
+
+    def _grid(self, w: DryWhirl, k_max: int
+              ) -> tuple[list[list[list[float]]], list[list[list[complex]]]]:
+        """The table's functions on the orbit's grid, fs[k][a][b] = sqrt(I_P) b_k (2 V_p)^k
+        (k <= k_max) and ds[k][a][b] = Q1 b'_k (2 V_p)^k/sqrt(I_P) + Q0 sqrt(I_P) b_(k-1)
+        (2 V_p)^(k-1) (D's part of order K^(1/2 - k), k <= k_max + 1, so that both of its
+        binomial tails start beyond k_max), at (beta_a, psi_b); the rows of N = alpha +
+        gamma K (``peak_on``) and d_scale >= |Q0| F + |Q1|/F over the band. Q0, Q1 from
+        the rolling forces of ``DryWhirl.beta_row`` at two levels (N + i F_t is linear in
+        Omega^2)."""
+        grid = w.beta_grid(_CB, _SB)
+        bF, bR = _series_b(False, k_max + 1), _series_b(True, k_max + 1)
+        K_a = 4.0 * _v_bound(w) + 1e-3 * self.K_lo  # (Omega^2 small: Q0 from it is not
+        K_b = self.K_hi                              # a difference of large values)
+        fs = [[[0.0] * N_PSI for _ in range(N_BETA)] for _ in range(k_max + 1)]
+        ds = [[[0j] * N_PSI for _ in range(N_BETA)] for _ in range(k_max + 2)]
+        self.d_scale = 0.0
+        self.n_rows: list[tuple[list[float], list[float]]] = []
+        c_r, Gx, Gy, mge = w.c_r, w.Gx, w.Gy, w.mge
+        for b in range(N_PSI):
+            ang = 2.0 * math.pi * b / N_PSI + w.phi
+            cE, sE = math.cos(ang), math.sin(ang)
+            _, d_a, _ = w.beta_row(grid, cE, sE, K_a - 2.0 * mge * sE)
+            _, d_b, _ = w.beta_row(grid, cE, sE, K_b - 2.0 * mge * sE)
+            alphas, gammas = [], []
+            for a, (cb, sb, IP) in enumerate(zip(grid[0], grid[1], grid[2])):
+                ct, st = cE * cb + sE * sb, sE * cb - cE * sb
+                v2 = 2.0 * (mge * sE - c_r * (Gx * ct + Gy * st))  # 2 V_p
+                om_a, om_b = (K_a - v2) / IP, (K_b - v2) / IP
+                z_a, z_b = d_a[a] * math.sqrt(om_a), d_b[a] * math.sqrt(om_b)  # N + i F_t
+                q1 = (z_b - z_a) / (om_b - om_a)
+                q0 = z_a - q1 * om_a
+                alphas.append(q0.real - q1.real * v2 / IP)
+                gammas.append(q1.real / IP)
+                sq = math.sqrt(IP)
+                self.d_scale = max(self.d_scale,
+                                   abs(q0) * math.sqrt(IP / (self.K_lo - v2))
+                                   + abs(q1) * math.sqrt((self.K_hi - v2) / IP))
+                x, x_prev = 1.0, 0.0
+                for k in range(k_max + 2):
+                    if k <= k_max:
+                        fs[k][a][b] = sq * bF[k] * x
+                    ds[k][a][b] = q1 / sq * bR[k] * x + (q0 * sq * bF[k - 1] * x_prev
+                                                         if k else 0j)
+                    x, x_prev = x * v2, x
+            self.n_rows.append((alphas, gammas))
+        return fs, ds
+
+    def _tables(self, w: DryWhirl, cf: list[dict[tuple[int, int], complex]],
+                cd: list[dict[tuple[int, int], complex]], tail: float) -> None:
+        """The harmonics kept (``Harmonic``), their magnitude bounds over the band sorted
+        largest first (for ``_orders``), the means and the error bounds."""
+        rho1, sig = 1.0 + w.rho, w.sig
+        lo_hi = (self.K_lo, self.K_hi)
+
+        def top(c: list[complex], p0: float) -> float:  # the largest over the band
+            return sum(abs(v) * max(K ** (p0 - k) for K in lo_hi) for k, v in enumerate(c))
+
+        f00 = [c[(0, 0)].real for c in cf]
+        d00 = [c[(0, 0)] for c in cd]
+        self.F00, self.D00 = f00, d00
+        f_min = min(sum(v * K ** (-0.5 - k) for k, v in enumerate(f00)) for K in lo_hi)
+        self.d00_min = min(abs(sum(v * K ** (0.5 - k) for k, v in enumerate(d00)))
+                           for K in lo_hi)
+        self.mean_f, self.mean_d = top(f00, -0.5), top(d00, 0.5)
+        k1, jp1 = K_BETA + 1, K_PSI + 1
+        err_t = [0.0, 0.0, tail * self.mean_f]  # (the binomial tail: slow)
+        err_d = [0.0, 0.0, tail * self.d_scale]
+        self.F, m_f = self._kept(cf, -0.5, True, TRIM_SHARE * TOL_PHASE * f_min, err_t,
+                                 rho1, sig, top)
+        self.D, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
+                                 err_d, rho1, sig, top)
+        for (j, jp) in ((j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)):
+            if abs(j) == k1 or abs(jp) == jp1:
+                _add(err_t, j, jp, 2.0 * top([c[(j, jp)] for c in cf], -0.5), rho1)
+                _add(err_d, j, jp, 2.0 * top([c[(j, jp)] for c in cd], 0.5), rho1)
+        self.err_t, self.err_d = tuple(err_t), tuple(err_d)
+        self.suf_f, self.suf_d = _suffix(m_f), _suffix(m_d)
+        self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
+                            + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge)
+                                     + abs(w.T)) / (self.K_lo - 2.0 * _v_bound(w)))
+        self.ok = all(map(math.isfinite, (*self.err_t, *self.err_d))) and self.d00_min > 0.0
+
+    @staticmethod
+    def _kept(cs: list[dict[tuple[int, int], complex]], p0: float, real: bool, budget: float,
+              err: list[float], rho1: float, sig: float, top: Any
+              ) -> tuple[list[Harmonic], list[float]]:
+        """The harmonics kept of a series (for a real one the half j > 0 or j = 0 < l):
+        its terms a_jlk, each at its largest over the band, are left out smallest first
+        while they sum to at most ``budget`` (doubled for a real series; added to ``err``:
+        a left-out term integrates to at most its size times the step's du, the bound
+        the tolerance is checked against); the harmonics sorted by their magnitude over
+        the band, largest first; and those magnitudes."""
+        sizes: dict[tuple[int, int], list[float]] = {}
+        for j in range(-K_BETA, K_BETA + 1):
+            for jp in range(-K_PSI, K_PSI + 1):
+                if (j, jp) != (0, 0) and (not real or j > 0 or (j == 0 and jp > 0)):
+                    sizes[(j, jp)] = [top([0j] * k + [v[(j, jp)]], p0)
+                                      for k, v in enumerate(cs)]
+        left, total = set(), 0.0
+        for hk in sorted(((jl, k) for jl, row in sizes.items() for k in range(len(row))),
+                         key=lambda e: sizes[e[0]][e[1]]):
+            size = sizes[hk[0]][hk[1]] * (2.0 if real else 1.0)
+            if total + size > budget:
+                break
+            total += size
+            left.add(hk)
+            _add(err, hk[0][0], hk[0][1], size, rho1)
+        out: list[tuple[float, Harmonic]] = []
+        for (j, jp), row in sizes.items():
+            keep = [k for k in range(len(row)) if ((j, jp), k) not in left]
+            if not keep:
+                continue
+            k_lo, k_hi = keep[0], keep[-1]
+            inv = 1.0 / (1j * sig * (j * rho1 + jp))
+            out.append((sum(row[k_lo:k_hi + 1]),
+                        (j, jp, k_lo, [v[(j, jp)] * inv for v in cs[k_lo:k_hi + 1]], inv)))
+        out.sort(key=lambda e: -e[0])
+        return [h for _, h in out], [m for m, _ in out]
+
+    def peak_on(self, psi_a: float, psi_b: float, K_a: float, K_b: float) -> float:
+        """The largest |N| (N) on the beta grid of the rows of the grid within [psi_a,
+        psi_b] (either order) widened by one row each way, at the levels K_a and K_b (N is
+        linear in K at each point): as ``Orbit.peak_on``."""
+        lo, hi = min(psi_a, psi_b), max(psi_a, psi_b)
+        k0 = math.floor(lo * N_PSI / (2.0 * math.pi))
+        k1 = min(math.floor(hi * N_PSI / (2.0 * math.pi)) + 1, k0 + N_PSI - 1)
+        out = 0.0
+        for k in range(k0, k1 + 1):
+            al, ga = self.n_rows[k % N_PSI]
+            for K in (K_a, K_b):
+                out = max(out, max(abs(a + g * K) for a, g in zip(al, ga)))
+        return out
+
+
+def _add(err: list[float], j: int, jp: int, size: float, rho1: float) -> None:
+    """Add a left-out harmonic of magnitude ``size`` to an error triple (``_dropped``'s:
+    sum 2 |c|/|w| and sum |c| over the fast ones, sum |c| over the slow ones)."""
+    if j:
+        err[0] += 2.0 * size / abs(j * rho1 + jp)
+        err[1] += size
+    else:
+        err[2] += size
+
+
+def _suffix(m: list[float]) -> list[float]:
+    """-s[i], s[i] = sum of m[i:] (s[len(m)] = 0): non-decreasing, for ``bisect``."""
+    out = [0.0] * (len(m) + 1)
+    for i in range(len(m) - 1, -1, -1):
+        out[i] = out[i + 1] - m[i]
+    return out
+
+
+def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, rem: float,
+            limit: int, step0: float) -> tuple[SegmentEnd | None, LevelTable | None]:
+    """Roll rem (s) from (theta, psi, Omega) under ``h`` (T_drive held, a c = 0) on the
+    table of its level's band: (the segment's end, the table). The end is None where the
+    method does not apply (module docstring): the caller advances the segment otherwise;
+    the table is returned all the same, so that a refused one is not rebuilt every step.
+    ``prev``: the previous step's table (or ``dry_whirl_orbit.Orbit``, or None)."""
+    w = DryWhirl(h, theta, psi, Omega)
+    if not (rem > 0.0 and w.K0 > 0.0 and math.isfinite(w.K0)) or w.rho < RHO_MIN:
+        return None, prev if isinstance(prev, LevelTable) else None
+    K_s = w.K0 + 2.0 * (w.mge * w.sE0 - w.v0)  # I_P Omega^2 + 2 V_p at the start
+    if not K_s > 0.0:
+        return None, None
+    key, band = level_key(h, Omega), band_of(K_s)
+    tab = prev if isinstance(prev, LevelTable) and prev.key == key and prev.band == band \
+        else None
+    if tab is None:
+        if limit < TABLE_WORK:
+            return None, None
+        tab = LevelTable(w, key, band)
+    if not tab.ok or limit < STEP_WORK:
+        return None, tab
+    du_hi = rem * tab.w_max * (1.0 + 1e-9)
+    du_lo = rem * tab.w_min * (1.0 - 1e-9)
+    dK = 2.0 * abs(w.T) * du_hi
+    if not (tab.K_lo <= K_s - dK and K_s + dK <= tab.K_hi and dK <= ORDER_DELTA * K_s
+            and _within_tolerance(tab, w, du_lo, du_hi)):
+        return None, tab
+    return _step(tab, w, psi, rem, K_s, du_hi, step0), tab
+
+
+def _within_tolerance(tab: LevelTable, w: DryWhirl, du: float, du_err: float) -> bool:
+    """The table's left-out parts over a step of du to du_err rad of psi (errors at
+    du_err, tolerances at du) within LEVEL_SHARE of TOL_PHASE (1 + its turn of theta) rad
+    of theta and of TOL_IMPULSE of its mean impulse (as ``dry_whirl_orbit``'s)."""
+    a, b, c = tab.err_t
+    e_t = min(a, b * du_err) + c * du_err
+    a, b, c = tab.err_d
+    e_d = min(a, b * du_err) + c * du_err
+    return (e_t * w.rho * tab.w_max <= LEVEL_SHARE * TOL_PHASE * (1.0 + w.rho * du)
+            and e_d <= LEVEL_SHARE * TOL_IMPULSE * tab.d00_min * du)
+
+
+class _StepSums:
+    """One series (F or D) of a table at a step's start level K_s: the rows of its n = 0
+    part for ``_series`` (the Levin Y_0 of each harmonic), the harmonics with orders n >= 1
+    and their Levin coefficients Y_1.. (``at``), and the mean's polynomial in s."""
+
+    __slots__ = ("corr", "mean", "rows")
+
+    def __init__(self, hs: list[Harmonic], suf: list[float], mean: list[Any], size: float,
+                 p0: float, bins: list[list[float]], K_s: float, delta: float, u_hi: float,
+                 budget: float) -> None:
+        r = 1.0 / K_s
+        P = [K_s ** p0]
+        for _ in range(len(bins) - 1):
+            P.append(P[-1] * r)
+        n_mean, lens = _orders(suf, size, bins, delta, u_hi, budget)
+        m = [sum(v * P[k] * bins[k][n] for k, v in enumerate(mean)) * delta ** n
+             for n in range(n_mean + 1)]
+        self.mean = [c / (n + 1) for n, c in enumerate(m)]  # its integral's, / s^(n+1)
+        corr = []
+        ys: dict[tuple[int, int], complex] = {}
+        for i, (j, jp, k_lo, a, inv) in enumerate(hs):
+            n_i = sum(1 for n_len in lens if i < n_len)
+            Pk = P[k_lo:]
+            if not n_i:
+                ys[(j, jp)] = sum(map(mul, a, Pk))
+                continue
+            g = [sum(v * Pk[k] * bins[k_lo + k][n] for k, v in enumerate(a)) * delta ** n
+                 for n in range(n_i + 1)]  # c^n/(i omega)
+            y = [0j] * (n_i + 1)
+            nxt = 0j
+            for n in range(n_i, -1, -1):  # Y_n = (c^n - (n + 1) Y_(n+1))/(i omega)
+                nxt = g[n] - (n + 1) * nxt * inv
+                y[n] = nxt
+            ys[(j, jp)] = y[0]
+            corr.append((float(j), float(jp), y[1:]))
+        self.corr = corr
+        self.rows = _rows(ys)
+
+    def at(self, beta: float, psi: float, u: float) -> complex:
+        """The periodic part's sum at (beta, psi) (rad) reached after u (rad): the rows
+        plus the orders n >= 1 of the corrected harmonics (0 at u = 0)."""
+        s = _series(self.rows, beta, psi, cmath.rect(1.0, psi))
+        if u:
+            for j, jp, y in self.corr:
+                acc = 0j
+                for c in reversed(y):
+                    acc = (acc + c) * u
+                s += cmath.rect(1.0, j * beta + jp * psi) * acc
+        return s
+
+    def integral(self, u: float) -> Any:
+        """int_0^u of the mean's polynomial."""
+        acc = 0.0 * self.mean[0]
+        for c in reversed(self.mean):
+            acc = (acc + c) * u
+        return acc
+
+
+def _orders(suf: list[float], size: float, bins: list[list[float]], delta: float, u: float,
+            budget: float) -> tuple[int, list[int]]:
+    """(the mean's highest order n, and for n = 1, 2, ..: the number of largest harmonics
+    whose order n is kept) so that what is left of each order integrates to at most
+    ``budget`` over u: |c^n| s^n integrates to at most M C_n (|delta| u)^n u for a harmonic
+    of magnitude M over the band (``suf``: ``_suffix`` of the sorted magnitudes, ``size``:
+    the mean's); C_n the largest |C(p0 - k, n)|. Stops at the first n that keeps none."""
+    q = abs(delta) * u
+    total = -suf[0]
+    lens: list[int] = []
+    n_mean = 0
+    for n in range(1, N_ORDERS + 1):
+        f = max(abs(row[n]) for row in bins) * q ** n * u
+        if max(total, size) * f <= budget:
+            break
+        if size * f > budget:
+            n_mean = n
+        lens.append(bisect.bisect_left(suf, -budget / f))  # first i with sum m[i:] <= it
+    return n_mean, lens
+
+
+def _rows(ys: dict[tuple[int, int], complex]) -> list[Row]:
+    """``_series``'s rows (over psi, one per beta harmonic j) of the coefficients ys."""
+    rows: dict[int, dict[int, complex]] = {}
+    for (j, jp), v in ys.items():
+        rows.setdefault(j, {})[jp] = v
+    out = []
+    for j, r in rows.items():
+        lo, hi = min(r), max(r)
+        vals = [r.get(jp, 0j) for jp in range(lo, hi + 1)]
+        out.append((float(j), float(lo), vals[-1], vals[-2::-1]))
+    return out
+
+
+def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_hi: float,
+          step0: float) -> SegmentEnd:
+    """The end of rem (s) of rolling from ``w``'s start at the level K_s (J): Newton on
+    t(u) = rem (t' = F on the path), then the impulse's sums at both ends."""
+    sig, rho1 = w.sig, 1.0 + w.rho
+    delta = 2.0 * w.T * sig / K_s
+    b_t = (1.0 - LEVEL_SHARE) * TOL_PHASE / (N_ORDERS * w.rho * tab.w_max)
+    b_d = (1.0 - LEVEL_SHARE) * TOL_IMPULSE * tab.d00_min * du_hi / N_ORDERS
+    # (the budgets of each degree n left out: time (s), t being twice the real part of its
+    # sum, and impulse (N s); du_hi bounds the step's u, its tolerance takes u >= du_lo)
+    sf = _StepSums(tab.F, tab.suf_f, tab.F00, tab.mean_f, -0.5, tab.bf, K_s, delta, du_hi,
+                   0.5 * b_t)
+    b_s = psi + w.phi - w.theta0
+    s_t0 = sf.at(b_s, psi, 0.0)
+    f00 = sf.mean[0]
+    u_lin = rem / f00
+    r0 = f00 * u_lin - rem
+    hi_mean = sf.mean[1:]
+
+    def residual(x: float) -> float:  # t(u_lin + x) - rem
+        u = u_lin + x
+        acc = 0.0
+        for c in reversed(hi_mean):
+            acc = (acc + c) * u
+        return r0 + f00 * x + acc * u + 2.0 * (sf.at(b_s + rho1 * sig * u, psi + sig * u, u)
+                                               - s_t0).real
+
+    u = rem * abs(w.Omega0)
+    x = 0.0 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u) - u_lin
+    for _ in range(NEWTON_ITERS):
+        du = residual(x) * w._speed(u_lin + x)
+        x = max(-u_lin, x - du)
+        if tab.kappa * du * du <= math.ulp(u_lin + x):
+            break
+    u = u_lin + x
+    sd = _StepSums(tab.D, tab.suf_d, tab.D00, tab.mean_d, 0.5, tab.bd, K_s, delta, du_hi,
+                   b_d)
+    b_e, p_e = b_s + rho1 * sig * u, psi + sig * u
+    P = sd.integral(u) + sd.at(b_e, p_e, u) - sd.at(b_s, psi, 0.0)
+    K_e = K_s + 2.0 * w.T * sig * u
+
+    def peak_on(psi_a: float, psi_b: float) -> float:
+        return tab.peak_on(psi_a, psi_b, K_s, K_e)
+
+    return segment_end(w, psi, rem, u, P, 0j, peak_on, STEP_WORK, step0, tab)
