@@ -32,7 +32,6 @@ from rotortd import SpinCore
 from rotortd.contact.search import SEGMENT_WORK
 from rotortd.params import RotorParams
 from rotortd.segments import dry_whirl_orbit as orbit_mod
-from rotortd.segments.dry_whirl_driven import LevelTable
 from rotortd.segments.rolling_spin_fast import DryWhirl
 from rotortd.segments.spin_contact import HeldInputs, SpinContact
 
@@ -202,7 +201,7 @@ def test_declines_where_it_must() -> None:
     W = 60.0
     driven = HeldInputs(p, J, 0.0, 0j, 5.0)
     seg = SpinContact(driven, 0.0, TH0, 0.0, PSI0, W)
-    assert isinstance(seg.run(H).orbit, LevelTable)  # T_drive != 0: dry_whirl_driven
+    assert seg.run(H).orbit is None  # T_drive != 0 at 60 rad/s: the direct panel (§10)
     cen = p.m * p.c_r * (p.R / p.c_r * W) ** 2
     n = complex(math.cos(TH0), math.sin(TH0))
     pulled = HeldInputs(p, J, 0.0, -0.99 * cen * n, 0.0)

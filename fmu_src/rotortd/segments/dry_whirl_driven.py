@@ -65,14 +65,13 @@ from .dry_whirl_orbit import (
     NEWTON_ITERS,
     RHO_MIN,
     Key,
-    Row,
     _dft2,
     _i_min,
     _series,
     _v_bound,
     segment_end,
 )
-from .rolling_spin_fast import SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
+from .rolling_spin_fast import BETA_DIRECT, SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
 
 if TYPE_CHECKING:
     from ..contact.wall import SegmentEnd
@@ -109,9 +108,9 @@ point and the DFTs); it is built only where the step's work limit covers this.""
 STEP_WORK = SAMPLE_WORK * (2 * NEWTON_ITERS + 5)
 """The work (units) charged for a step (as ``dry_whirl_orbit``'s)."""
 
-Harmonic = tuple[int, int, int, list[complex], complex]
-"""One harmonic of a table: (j, l, k_lo, the coefficients a_jlk/(i sigma w_jl) from order
-k_lo on, 1/(i sigma w_jl))."""
+Harmonic = tuple[float, float, list[complex], complex]
+"""One harmonic of a table: (j, l, its coefficients a_jlk/(i sigma w_jl) for every order k,
+zero where left out, 1/(i sigma w_jl))."""
 
 
 def _binomials(p0: float, k_max: int) -> list[list[float]]:
@@ -153,9 +152,9 @@ class LevelTable:
     levels; ``ok`` False where it cannot serve (eps too large, an event not excluded, the
     series do not converge within the tolerance)."""
 
-    __slots__ = ("D", "D00", "F", "F00", "K_hi", "K_lo", "band", "bd", "bf", "d00_min",
-                 "d_scale", "err_d", "err_t", "k_max", "kappa", "key", "mean_d", "mean_f",
-                 "n_rows", "ok", "suf_d", "suf_f", "w_max", "w_min")
+    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "bd", "bf", "d00_min", "d_scale", "err_d",
+                 "err_t", "k_max", "kappa", "key", "mean_d", "mean_f", "n_rows", "ok",
+                 "w_max", "w_min")
 
     def __init__(self, w: DryWhirl, key: Key, band: int) -> None:
         self.key, self.band, self.ok = key, band, False
@@ -240,7 +239,6 @@ class LevelTable:
 
         f00 = [c[(0, 0)].real for c in cf]
         d00 = [c[(0, 0)] for c in cd]
-        self.F00, self.D00 = f00, d00
         f_min = min(sum(v * K ** (-0.5 - k) for k, v in enumerate(f00)) for K in lo_hi)
         self.d00_min = min(abs(sum(v * K ** (0.5 - k) for k, v in enumerate(d00)))
                            for K in lo_hi)
@@ -248,16 +246,17 @@ class LevelTable:
         k1, jp1 = K_BETA + 1, K_PSI + 1
         err_t = [0.0, 0.0, tail * self.mean_f]  # (the binomial tail: slow)
         err_d = [0.0, 0.0, tail * self.d_scale]
-        self.F, m_f = self._kept(cf, -0.5, True, TRIM_SHARE * TOL_PHASE * f_min, err_t,
-                                 rho1, sig, top)
-        self.D, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
-                                 err_d, rho1, sig, top)
+        hf, m_f = self._kept(cf, -0.5, True, TRIM_SHARE * TOL_PHASE * f_min, err_t,
+                             rho1, sig, top)
+        hd, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
+                             err_d, rho1, sig, top)
+        self.F = _Series(hf, m_f, f00, self.mean_f, self.bf)
+        self.D = _Series(hd, m_d, d00, self.mean_d, self.bd)
         for (j, jp) in ((j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)):
             if abs(j) == k1 or abs(jp) == jp1:
                 _add(err_t, j, jp, 2.0 * top([c[(j, jp)] for c in cf], -0.5), rho1)
                 _add(err_d, j, jp, 2.0 * top([c[(j, jp)] for c in cd], 0.5), rho1)
         self.err_t, self.err_d = tuple(err_t), tuple(err_d)
-        self.suf_f, self.suf_d = _suffix(m_f), _suffix(m_d)
         self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
                             + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge)
                                      + abs(w.T)) / (self.K_lo - 2.0 * _v_bound(w)))
@@ -293,10 +292,10 @@ class LevelTable:
             keep = [k for k in range(len(row)) if ((j, jp), k) not in left]
             if not keep:
                 continue
-            k_lo, k_hi = keep[0], keep[-1]
             inv = 1.0 / (1j * sig * (j * rho1 + jp))
-            out.append((sum(row[k_lo:k_hi + 1]),
-                        (j, jp, k_lo, [v[(j, jp)] * inv for v in cs[k_lo:k_hi + 1]], inv)))
+            out.append((sum(row[k] for k in keep),
+                        (float(j), float(jp), [v[(j, jp)] * inv if k in keep else 0j
+                                               for k, v in enumerate(cs)], inv)))
         out.sort(key=lambda e: -e[0])
         return [h for _, h in out], [m for m, _ in out]
 
@@ -325,14 +324,6 @@ def _add(err: list[float], j: int, jp: int, size: float, rho1: float) -> None:
         err[2] += size
 
 
-def _suffix(m: list[float]) -> list[float]:
-    """-s[i], s[i] = sum of m[i:] (s[len(m)] = 0): non-decreasing, for ``bisect``."""
-    out = [0.0] * (len(m) + 1)
-    for i in range(len(m) - 1, -1, -1):
-        out[i] = out[i + 1] - m[i]
-    return out
-
-
 def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, rem: float,
             limit: int, step0: float) -> tuple[SegmentEnd | None, LevelTable | None]:
     """Roll rem (s) from (theta, psi, Omega) under ``h`` (T_drive held, a c = 0) on the
@@ -341,8 +332,12 @@ def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, re
     the table is returned all the same, so that a refused one is not rebuilt every step.
     ``prev``: the previous step's table (or ``dry_whirl_orbit.Orbit``, or None)."""
     w = DryWhirl(h, theta, psi, Omega)
+    keep = prev if isinstance(prev, LevelTable) else None
     if not (rem > 0.0 and w.K0 > 0.0 and math.isfinite(w.K0)) or w.rho < RHO_MIN:
-        return None, prev if isinstance(prev, LevelTable) else None
+        return None, keep
+    L = w.panel_length(rem)
+    if L is not None and w.rho * L <= BETA_DIRECT:
+        return None, keep  # (the direct panel takes it, at less work: §10)
     K_s = w.K0 + 2.0 * (w.mge * w.sE0 - w.v0)  # I_P Omega^2 + 2 V_p at the start
     if not K_s > 0.0:
         return None, None
@@ -376,43 +371,73 @@ def _within_tolerance(tab: LevelTable, w: DryWhirl, du: float, du_err: float) ->
             and e_d <= LEVEL_SHARE * TOL_IMPULSE * tab.d00_min * du)
 
 
+class _Series:
+    """One series (F or D) of a table: its harmonics sorted largest first (``Harmonic``),
+    the negated suffix sums of their magnitudes over the band (``_orders``), its mean's
+    coefficients a_00k and magnitude, the binomials C(p0 - k, n) (row k), and the
+    structure of ``_series``'s rows over psi: (j, l of the lowest term, the harmonics' indices
+    from the highest l down, -1 for none)."""
+
+    __slots__ = ("bins", "cmax", "hs", "mean", "neg_suf", "rows", "size")
+
+    def __init__(self, hs: list[Harmonic], mags: list[float], mean: list[Any], size: float,
+                 bins: list[list[float]]) -> None:
+        self.hs, self.mean, self.size, self.bins = hs, mean, size, bins
+        self.cmax = [max(abs(row[n]) for row in bins) for n in range(N_ORDERS + 1)]
+        self.neg_suf = [0.0] * (len(mags) + 1)  # -sum of mags[i:]: non-decreasing
+        for i in range(len(mags) - 1, -1, -1):
+            self.neg_suf[i] = self.neg_suf[i + 1] - mags[i]
+        by_row: dict[float, dict[float, int]] = {}
+        for i, (j, jp, _, _) in enumerate(hs):
+            by_row.setdefault(j, {})[jp] = i
+        self.rows = []
+        for j, r in sorted(by_row.items()):
+            lo, hi = int(min(r)), int(max(r))
+            idx = [r.get(float(jp), -1) for jp in range(hi, lo - 1, -1)]
+            self.rows.append((j, float(lo), idx))
+
+
 class _StepSums:
-    """One series (F or D) of a table at a step's start level K_s: the rows of its n = 0
-    part for ``_series`` (the Levin Y_0 of each harmonic), the harmonics with orders n >= 1
-    and their Levin coefficients Y_1.. (``at``), and the mean's polynomial in s."""
+    """A ``_Series`` at a step's start level K_s (J), delta = 2 T sigma/K_s: the rows of
+    its sums for ``_series`` (each harmonic's Levin Y_0), the harmonics with orders
+    n >= 1 and their Levin coefficients Y_1.. (``at``), and the mean's integral's
+    coefficients."""
 
     __slots__ = ("corr", "mean", "rows")
 
-    def __init__(self, hs: list[Harmonic], suf: list[float], mean: list[Any], size: float,
-                 p0: float, bins: list[list[float]], K_s: float, delta: float, u_hi: float,
+    def __init__(self, ser: _Series, p0: float, K_s: float, delta: float, u_hi: float,
                  budget: float) -> None:
-        r = 1.0 / K_s
+        bins = ser.bins
         P = [K_s ** p0]
+        r = 1.0 / K_s
         for _ in range(len(bins) - 1):
             P.append(P[-1] * r)
-        n_mean, lens = _orders(suf, size, bins, delta, u_hi, budget)
-        m = [sum(v * P[k] * bins[k][n] for k, v in enumerate(mean)) * delta ** n
-             for n in range(n_mean + 1)]
-        self.mean = [c / (n + 1) for n, c in enumerate(m)]  # its integral's, / s^(n+1)
+        n_mean, lens = _orders(ser, delta, u_hi, budget)
+        n_top = max(n_mean, len(lens))
+        Wn = [P]  # Wn[n][k] = delta^n P_k C(p0 - k, n)
+        dn = 1.0
+        for n in range(1, n_top + 1):
+            dn *= delta
+            Wn.append([pk * row[n] * dn for pk, row in zip(P, bins)])
+        self.mean = [sum(map(mul, ser.mean, Wn[n])) / (n + 1) for n in range(n_mean + 1)]
+        hs = ser.hs
+        ys = [sum(map(mul, h[2], P)) for h in hs]  # Y_0 = c^0/(i omega) where n = 0 only
         corr = []
-        ys: dict[tuple[int, int], complex] = {}
-        for i, (j, jp, k_lo, a, inv) in enumerate(hs):
-            n_i = sum(1 for n_len in lens if i < n_len)
-            Pk = P[k_lo:]
-            if not n_i:
-                ys[(j, jp)] = sum(map(mul, a, Pk))
-                continue
-            g = [sum(v * Pk[k] * bins[k_lo + k][n] for k, v in enumerate(a)) * delta ** n
-                 for n in range(n_i + 1)]  # c^n/(i omega)
-            y = [0j] * (n_i + 1)
+        n_i = len(lens)
+        for i in range(lens[0] if lens else 0):
+            while n_i and i >= lens[n_i - 1]:
+                n_i -= 1
+            j, jp, a, inv = hs[i]
             nxt = 0j
-            for n in range(n_i, -1, -1):  # Y_n = (c^n - (n + 1) Y_(n+1))/(i omega)
-                nxt = g[n] - (n + 1) * nxt * inv
-                y[n] = nxt
-            ys[(j, jp)] = y[0]
-            corr.append((float(j), float(jp), y[1:]))
+            y = []
+            for n in range(n_i, 0, -1):  # Y_n = (c^n - (n + 1) Y_(n+1))/(i omega)
+                nxt = sum(map(mul, a, Wn[n])) - (n + 1) * nxt * inv
+                y.append(nxt)
+            ys[i] -= nxt * inv
+            corr.append((j, jp, y))  # (Y_n from the highest n down)
         self.corr = corr
-        self.rows = _rows(ys)
+        self.rows = [(j, lo, ys[idx[0]], [ys[k] if k >= 0 else 0j for k in idx[1:]])
+                     for j, lo, idx in ser.rows]
 
     def at(self, beta: float, psi: float, u: float) -> complex:
         """The periodic part's sum at (beta, psi) (rad) reached after u (rad): the rows
@@ -421,7 +446,7 @@ class _StepSums:
         if u:
             for j, jp, y in self.corr:
                 acc = 0j
-                for c in reversed(y):
+                for c in y:
                     acc = (acc + c) * u
                 s += cmath.rect(1.0, j * beta + jp * psi) * acc
         return s
@@ -434,38 +459,26 @@ class _StepSums:
         return acc
 
 
-def _orders(suf: list[float], size: float, bins: list[list[float]], delta: float, u: float,
-            budget: float) -> tuple[int, list[int]]:
+def _orders(ser: _Series, delta: float, u: float, budget: float) -> tuple[int, list[int]]:
     """(the mean's highest order n, and for n = 1, 2, ..: the number of largest harmonics
     whose order n is kept) so that what is left of each order integrates to at most
     ``budget`` over u: |c^n| s^n integrates to at most M C_n (|delta| u)^n u for a harmonic
-    of magnitude M over the band (``suf``: ``_suffix`` of the sorted magnitudes, ``size``:
-    the mean's); C_n the largest |C(p0 - k, n)|. Stops at the first n that keeps none."""
+    of magnitude M over the band, C_n the largest |C(p0 - k, n)|. Stops at the first n
+    that keeps none."""
     q = abs(delta) * u
-    total = -suf[0]
+    total, size, neg_suf = -ser.neg_suf[0], ser.size, ser.neg_suf
     lens: list[int] = []
     n_mean = 0
+    f = u
     for n in range(1, N_ORDERS + 1):
-        f = max(abs(row[n]) for row in bins) * q ** n * u
-        if max(total, size) * f <= budget:
+        f *= q
+        fc = f * ser.cmax[n]
+        if max(total, size) * fc <= budget:
             break
-        if size * f > budget:
+        if size * fc > budget:
             n_mean = n
-        lens.append(bisect.bisect_left(suf, -budget / f))  # first i with sum m[i:] <= it
+        lens.append(bisect.bisect_left(neg_suf, -budget / fc))  # first i: sum m[i:] <= it
     return n_mean, lens
-
-
-def _rows(ys: dict[tuple[int, int], complex]) -> list[Row]:
-    """``_series``'s rows (over psi, one per beta harmonic j) of the coefficients ys."""
-    rows: dict[int, dict[int, complex]] = {}
-    for (j, jp), v in ys.items():
-        rows.setdefault(j, {})[jp] = v
-    out = []
-    for j, r in rows.items():
-        lo, hi = min(r), max(r)
-        vals = [r.get(jp, 0j) for jp in range(lo, hi + 1)]
-        out.append((float(j), float(lo), vals[-1], vals[-2::-1]))
-    return out
 
 
 def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_hi: float,
@@ -478,8 +491,7 @@ def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_h
     b_d = (1.0 - LEVEL_SHARE) * TOL_IMPULSE * tab.d00_min * du_hi / N_ORDERS
     # (the budgets of each degree n left out: time (s), t being twice the real part of its
     # sum, and impulse (N s); du_hi bounds the step's u, its tolerance takes u >= du_lo)
-    sf = _StepSums(tab.F, tab.suf_f, tab.F00, tab.mean_f, -0.5, tab.bf, K_s, delta, du_hi,
-                   0.5 * b_t)
+    sf = _StepSums(tab.F, -0.5, K_s, delta, du_hi, 0.5 * b_t)
     b_s = psi + w.phi - w.theta0
     s_t0 = sf.at(b_s, psi, 0.0)
     f00 = sf.mean[0]
@@ -503,8 +515,7 @@ def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_h
         if tab.kappa * du * du <= math.ulp(u_lin + x):
             break
     u = u_lin + x
-    sd = _StepSums(tab.D, tab.suf_d, tab.D00, tab.mean_d, 0.5, tab.bd, K_s, delta, du_hi,
-                   b_d)
+    sd = _StepSums(tab.D, 0.5, K_s, delta, du_hi, b_d)
     b_e, p_e = b_s + rho1 * sig * u, psi + sig * u
     P = sd.integral(u) + sd.at(b_e, p_e, u) - sd.at(b_s, psi, 0.0)
     K_e = K_s + 2.0 * w.T * sig * u

@@ -274,10 +274,9 @@ class DryWhirl:
         direct when the panel's theta turn is at most BETA_DIRECT, else Fourier-Levin)."""
         if not (rem > 0.0 and self.K0 > 0.0 and math.isfinite(self.K0)):
             return None
-        lo, hi = self._omega2_bounds(L_MAX)
-        if not lo > 0.5 * self.Omega0 * self.Omega0:
+        L = self.panel_length(rem)
+        if L is None:
             return None
-        L = min(L_MAX, rem * math.sqrt(hi) * (1.0 + 1e-9))
         direct = self.rho * L <= BETA_DIRECT if levin is None else not levin
         if not direct and max(L, 2.0 * (P_CHEB + 1) / (1.0 + self.rho)) > L_MAX:
             return None
@@ -295,6 +294,16 @@ class DryWhirl:
         else:
             u, dur = self._newton(panel, rem, L), rem
         return self._end(panel, u, dur, work, step0)
+
+    def panel_length(self, rem: float) -> float | None:
+        """The panel's length (rad of psi) for rem (s): enough to reach rem at the largest
+        speed the energy allows over L_MAX, at most L_MAX; None where that speed bound is
+        not usable (Omega^2 may fall below half its start's over L_MAX). Its turn of theta,
+        rho L, selects the direct panel (at most BETA_DIRECT)."""
+        lo, hi = self._omega2_bounds(L_MAX)
+        if not lo > 0.5 * self.Omega0 * self.Omega0:
+            return None
+        return min(L_MAX, rem * math.sqrt(hi) * (1.0 + 1e-9))
 
     def _panel(self, L: float, direct: bool) -> _DirectPanel | _LevinPanel | None:
         """The panel of at least L (rad of psi) whose events are excluded and whose error
