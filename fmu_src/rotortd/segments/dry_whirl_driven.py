@@ -48,7 +48,6 @@ step's work limit covers it), so that the work counts are the state's alone.
 
 from __future__ import annotations
 
-import bisect
 import cmath
 import math
 from operator import mul
@@ -65,6 +64,7 @@ from .dry_whirl_orbit import (
     NEWTON_ITERS,
     RHO_MIN,
     Key,
+    Row,
     _dft2,
     _i_min,
     _series,
@@ -94,9 +94,12 @@ TRIM_SHARE = 0.3
 per radian of psi (TOL_PHASE of the mean of F, TOL_IMPULSE of the mean of D)."""
 LEVEL_SHARE = 0.9
 """The share of the step's tolerance that the table's left-out parts may take."""
-ORDER_SHARE = 0.01
-"""The share of the step's tolerance that the orders n of each degree left out may take
-(at most N_ORDERS degrees: 1 - LEVEL_SHARE in all)."""
+ORDER_SHARE = 0.05
+"""The share of the step's tolerance that the orders n of the level's polynomial in s left
+out may take."""
+M_SHARE = 0.05
+"""The share of the step's tolerance that the Levin terms m >= 1 left out may take
+(``_Series``)."""
 N_ORDERS = 10
 """Most degrees n of the polynomials in s (the relative change of K over a step,
 |delta| u, is then at most ORDER_DELTA)."""
@@ -114,11 +117,11 @@ zero where left out, 1/(i sigma w_jl))."""
 
 
 def _binomials(p0: float, k_max: int) -> list[list[float]]:
-    """C(p0 - k, n) for k = 0..k_max, n = 0..N_ORDERS (generalised binomials)."""
+    """C(p0 - k, n) for k = 0..k_max, n = 0..2 N_ORDERS (generalised binomials)."""
     out = []
     for k in range(k_max + 1):
         row, c = [], 1.0
-        for n in range(N_ORDERS + 1):
+        for n in range(2 * N_ORDERS + 1):
             row.append(c)
             c *= (p0 - k - n) / (n + 1)
         out.append(row)
@@ -152,9 +155,9 @@ class LevelTable:
     levels; ``ok`` False where it cannot serve (eps too large, an event not excluded, the
     series do not converge within the tolerance)."""
 
-    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "bd", "bf", "d00_min", "d_scale", "err_d",
-                 "err_t", "k_max", "kappa", "key", "mean_d", "mean_f", "n_rows", "ok",
-                 "w_max", "w_min")
+    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "bd", "bf", "d00_min", "d_scale", "du_min",
+                 "err_d", "err_t", "k_max", "kappa", "key", "mean_d", "mean_f", "n_rising",
+                 "n_rows", "ok", "w_max", "w_min")
 
     def __init__(self, w: DryWhirl, key: Key, band: int) -> None:
         self.key, self.band, self.ok = key, band, False
@@ -225,6 +228,9 @@ class LevelTable:
                                                          if k else 0j)
                     x, x_prev = x * v2, x
             self.n_rows.append((alphas, gammas))
+        self.n_rising = all(g >= 0.0 for _, ga in self.n_rows for g in ga)
+        """N grows with K at every point of the grid (the centripetal term): the peak over
+        a step's levels is at the larger."""
         return fs, ds
 
     def _tables(self, w: DryWhirl, cf: list[dict[tuple[int, int], complex]],
@@ -250,8 +256,15 @@ class LevelTable:
                              rho1, sig, top)
         hd, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
                              err_d, rho1, sig, top)
-        self.F = _Series(hf, m_f, f00, self.mean_f, self.bf)
-        self.D = _Series(hd, m_d, d00, self.mean_d, self.bd)
+        delta_max = 2.0 * abs(w.T) / self.K_lo
+        self.du_min = 0.5 * BETA_DIRECT / w.rho * self.w_min / self.w_max
+        tol_t = TOL_PHASE / (w.rho * self.w_max)  # (s: TOL_PHASE rad of theta)
+        self.F = _Series(hf, m_f, f00, self.mean_f, -0.5, self.bf,
+                         [max(K ** (-0.5 - k) for K in lo_hi) for k in range(len(self.bf))],
+                         delta_max, M_SHARE * tol_t / 4.0)  # (t: twice the real part, 2 ends)
+        self.D = _Series(hd, m_d, d00, self.mean_d, 0.5, self.bd,
+                         [max(K ** (0.5 - k) for K in lo_hi) for k in range(len(self.bd))],
+                         delta_max, M_SHARE * TOL_IMPULSE * self.d00_min * self.du_min / 2.0)
         for (j, jp) in ((j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)):
             if abs(j) == k1 or abs(jp) == jp1:
                 _add(err_t, j, jp, 2.0 * top([c[(j, jp)] for c in cf], -0.5), rho1)
@@ -307,10 +320,11 @@ class LevelTable:
         k0 = math.floor(lo * N_PSI / (2.0 * math.pi))
         k1 = min(math.floor(hi * N_PSI / (2.0 * math.pi)) + 1, k0 + N_PSI - 1)
         out = 0.0
+        levels = (max(K_a, K_b),) if self.n_rising else (K_a, K_b)
         for k in range(k0, k1 + 1):
             al, ga = self.n_rows[k % N_PSI]
-            for K in (K_a, K_b):
-                out = max(out, max(abs(a + g * K) for a, g in zip(al, ga)))
+            for K in levels:  # (N > 0 over the band, _no_event: |N| = N)
+                out = max(out, max([a + g * K for a, g in zip(al, ga)]))
         return out
 
 
@@ -354,9 +368,9 @@ def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, re
     du_lo = rem * tab.w_min * (1.0 - 1e-9)
     dK = 2.0 * abs(w.T) * du_hi
     if not (tab.K_lo <= K_s - dK and K_s + dK <= tab.K_hi and dK <= ORDER_DELTA * K_s
-            and _within_tolerance(tab, w, du_lo, du_hi)):
+            and du_lo >= tab.du_min and _within_tolerance(tab, w, du_lo, du_hi)):
         return None, tab
-    return _step(tab, w, psi, rem, K_s, du_hi, step0), tab
+    return _step(tab, w, psi, rem, K_s, du_lo, du_hi, step0), tab
 
 
 def _within_tolerance(tab: LevelTable, w: DryWhirl, du: float, du_err: float) -> bool:
@@ -372,38 +386,64 @@ def _within_tolerance(tab: LevelTable, w: DryWhirl, du: float, du_err: float) ->
 
 
 class _Series:
-    """One series (F or D) of a table: its harmonics sorted largest first (``Harmonic``),
-    the negated suffix sums of their magnitudes over the band (``_orders``), its mean's
-    coefficients a_00k and magnitude, the binomials C(p0 - k, n) (row k), and the
-    structure of ``_series``'s rows over psi: (j, l of the lowest term, the harmonics' indices
-    from the highest l down, -1 for none)."""
+    """One series (F or D) of a table as fixed 2-D sums, one group of ``_series`` rows per
+    order k of the level and per Levin order m (docs/notes/dry-whirl-quadrature.md §10):
 
-    __slots__ = ("bins", "cmax", "hs", "mean", "neg_suf", "rows", "size")
+        S_km(beta, psi) = sum_jl a_jlk/(i sigma w_jl)^(m+1) e^{i (j beta + l psi)},
+
+    so that the periodic part of the integral at a step's level is sum_km w_km(u) S_km with
+    scalar weights (``_StepSums``): no coefficient is rebuilt per step. m = 0 holds every
+    kept term; m >= 1 the terms whose largest use over the band (m! (|delta| /|w|)^m of
+    the m = 0 term, delta at most 2 |T|/K_lo, over 1 - ORDER_DELTA to the power m + 1) is
+    above what ``m_budget`` leaves out (smallest first; their sum is ``left``, an absolute
+    bound of the step's error in the sum at either end). Also the mean's a_00k and its
+    magnitude over the band, the total magnitude of the harmonics, the binomials
+    C(p0 - k, n) (row k) and their largest modulus per n. ``scale[k]``: the largest
+    K^(p0 - k) over the band."""
+
+    __slots__ = ("bins", "cmax", "facs", "groups", "left", "m_top", "mean", "size", "total")
 
     def __init__(self, hs: list[Harmonic], mags: list[float], mean: list[Any], size: float,
-                 bins: list[list[float]]) -> None:
-        self.hs, self.mean, self.size, self.bins = hs, mean, size, bins
+                 p0: float, bins: list[list[float]], scale: list[float], delta_max: float,
+                 m_budget: float) -> None:
+        self.mean, self.size, self.bins, self.total = mean, size, bins, sum(mags)
         self.cmax = [max(abs(row[n]) for row in bins) for n in range(N_ORDERS + 1)]
-        self.neg_suf = [0.0] * (len(mags) + 1)  # -sum of mags[i:]: non-decreasing
-        for i in range(len(mags) - 1, -1, -1):
-            self.neg_suf[i] = self.neg_suf[i + 1] - mags[i]
-        by_row: dict[float, dict[float, int]] = {}
-        for i, (j, jp, _, _) in enumerate(hs):
-            by_row.setdefault(j, {})[jp] = i
-        self.rows = []
-        for j, r in sorted(by_row.items()):
-            lo, hi = int(min(r)), int(max(r))
-            idx = [r.get(float(jp), -1) for jp in range(hi, lo - 1, -1)]
-            self.rows.append((j, float(lo), idx))
+        terms = []  # (bound of its use, m, k, j, l, coefficient)
+        for j, jp, a, inv in hs:
+            w_inv = abs(inv)
+            for k, v in enumerate(a):
+                if not v:
+                    continue
+                terms.append((0.0, 0, k, j, jp, v))
+                use, c, m = abs(v) * scale[k], v, 0
+                while use > 0.0 and m < N_ORDERS:
+                    m += 1  # (m! C(p0 - k, m) from (m - 1)! C(p0 - k, m - 1))
+                    c *= inv
+                    use *= abs(p0 - k - m + 1) * delta_max * w_inv / (1.0 - ORDER_DELTA)
+                    terms.append((use / (1.0 - ORDER_DELTA), m, k, j, jp, c))
+        self.left, kept = 0.0, []
+        for t in sorted(terms, key=lambda t: t[0]):
+            if t[1] and self.left + t[0] <= m_budget:
+                self.left += t[0]
+            else:
+                kept.append(t)
+        by_group: dict[tuple[int, int], dict[tuple[float, float], complex]] = {}
+        for _, m, k, j, jp, c in kept:
+            by_group.setdefault((k, m), {})[(j, jp)] = c
+        self.groups = [(k, m, *_rows(entries)) for (k, m), entries in sorted(by_group.items())]
+        self.m_top = max(m for _, m, _, _ in self.groups)
+        self.facs = [[(-1.0 if m % 2 else 1.0) * math.perm(q + m, m)
+                      for q in range(N_ORDERS + 1)] for _, m, _, _ in self.groups]
+        """(-1)^m (q + m)!/q! of each group (``_StepSums``'s weights)."""
 
 
 class _StepSums:
-    """A ``_Series`` at a step's start level K_s (J), delta = 2 T sigma/K_s: the rows of
-    its sums for ``_series`` (each harmonic's Levin Y_0), the harmonics with orders
-    n >= 1 and their Levin coefficients Y_1.. (``at``), and the mean's integral's
-    coefficients."""
+    """A ``_Series`` at a step's start level K_s (J), delta = 2 T sigma/K_s: each group's
+    weight as a polynomial in u (Levin: int_0^u P(s) e^{i w s} ds = [Y(s) e^{i w s}],
+    Y = sum_m (-1)^m P^(m)/(i w)^(m+1), P(s) = sum_n c^n s^n, c^n = sum_k a_k W_nk,
+    W_nk = delta^n K_s^(p0-k) C(p0 - k, n)), and the mean's integral."""
 
-    __slots__ = ("corr", "mean", "rows")
+    __slots__ = ("items", "mean")
 
     def __init__(self, ser: _Series, p0: float, K_s: float, delta: float, u_hi: float,
                  budget: float) -> None:
@@ -412,43 +452,29 @@ class _StepSums:
         r = 1.0 / K_s
         for _ in range(len(bins) - 1):
             P.append(P[-1] * r)
-        n_mean, lens = _orders(ser, delta, u_hi, budget)
-        n_top = max(n_mean, len(lens))
+        n_top = _orders(ser, delta, u_hi, budget)
         Wn = [P]  # Wn[n][k] = delta^n P_k C(p0 - k, n)
         dn = 1.0
-        for n in range(1, n_top + 1):
+        for n in range(1, n_top + ser.m_top + 1):
             dn *= delta
             Wn.append([pk * row[n] * dn for pk, row in zip(P, bins)])
-        self.mean = [sum(map(mul, ser.mean, Wn[n])) / (n + 1) for n in range(n_mean + 1)]
-        hs = ser.hs
-        ys = [sum(map(mul, h[2], P)) for h in hs]  # Y_0 = c^0/(i omega) where n = 0 only
-        corr = []
-        n_i = len(lens)
-        for i in range(lens[0] if lens else 0):
-            while n_i and i >= lens[n_i - 1]:
-                n_i -= 1
-            j, jp, a, inv = hs[i]
-            nxt = 0j
-            y = []
-            for n in range(n_i, 0, -1):  # Y_n = (c^n - (n + 1) Y_(n+1))/(i omega)
-                nxt = sum(map(mul, a, Wn[n])) - (n + 1) * nxt * inv
-                y.append(nxt)
-            ys[i] -= nxt * inv
-            corr.append((j, jp, y))  # (Y_n from the highest n down)
-        self.corr = corr
-        self.rows = [(j, lo, ys[idx[0]], [ys[k] if k >= 0 else 0j for k in idx[1:]])
-                     for j, lo, idx in ser.rows]
+        self.mean = [sum(map(mul, ser.mean, Wn[n])) / (n + 1) for n in range(n_top + 1)]
+        qs = range(n_top, -1, -1)
+        self.items = [([fac[q] * Wn[q + m][k] for q in qs], by_beta, rows)
+                      for (k, m, by_beta, rows), fac in zip(ser.groups, ser.facs)]
+        """Each group's weight as a polynomial in u (its coefficients, highest first), its
+        rows' orientation and its rows."""
 
     def at(self, beta: float, psi: float, u: float) -> complex:
-        """The periodic part's sum at (beta, psi) (rad) reached after u (rad): the rows
-        plus the orders n >= 1 of the corrected harmonics (0 at u = 0)."""
-        s = _series(self.rows, beta, psi, cmath.rect(1.0, psi))
-        if u:
-            for j, jp, y in self.corr:
-                acc = 0j
-                for c in y:
-                    acc = (acc + c) * u
-                s += cmath.rect(1.0, j * beta + jp * psi) * acc
+        """sum_km w_km(u) S_km(beta, psi): the periodic part's Levin sum at (beta, psi) (rad)
+        reached after u (rad)."""
+        zs = (cmath.rect(1.0, psi), cmath.rect(1.0, beta))
+        s = 0j
+        for poly, by_beta, rows in self.items:
+            w = 0.0
+            for c in poly:
+                w = w * u + c
+            s += w * _series(rows, beta, psi, zs[by_beta])
         return s
 
     def integral(self, u: float) -> Any:
@@ -459,39 +485,50 @@ class _StepSums:
         return acc
 
 
-def _orders(ser: _Series, delta: float, u: float, budget: float) -> tuple[int, list[int]]:
-    """(the mean's highest order n, and for n = 1, 2, ..: the number of largest harmonics
-    whose order n is kept) so that what is left of each order integrates to at most
-    ``budget`` over u: |c^n| s^n integrates to at most M C_n (|delta| u)^n u for a harmonic
-    of magnitude M over the band, C_n the largest |C(p0 - k, n)|. Stops at the first n
-    that keeps none."""
+def _orders(ser: _Series, delta: float, u: float, budget: float) -> int:
+    """The highest order n of the level's polynomial in s kept: what is left of each
+    higher order integrates to at most ``budget`` over u (|c^n| s^n to at most
+    M C_n (|delta| u)^n u for a harmonic of magnitude M over the band, C_n the largest
+    |C(p0 - k, n)|)."""
     q = abs(delta) * u
-    total, size, neg_suf = -ser.neg_suf[0], ser.size, ser.neg_suf
-    lens: list[int] = []
-    n_mean = 0
+    big = max(ser.total, ser.size)
     f = u
     for n in range(1, N_ORDERS + 1):
         f *= q
-        fc = f * ser.cmax[n]
-        if max(total, size) * fc <= budget:
-            break
-        if size * fc > budget:
-            n_mean = n
-        lens.append(bisect.bisect_left(neg_suf, -budget / fc))  # first i: sum m[i:] <= it
-    return n_mean, lens
+        if big * f * ser.cmax[n] <= budget:
+            return n - 1
+    return N_ORDERS
 
 
-def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_hi: float,
-          step0: float) -> SegmentEnd:
+def _rows(entries: dict[tuple[float, float], complex]) -> tuple[bool, list[Row]]:
+    """``_series``'s rows of the terms c_jl of ``entries``, over psi (one row per j) or over
+    beta (one per l), whichever takes fewer: (over beta, the rows)."""
+    out: tuple[list[Row], list[Row]] = ([], [])
+    for by_beta in (False, True):
+        rows: dict[float, dict[int, complex]] = {}
+        for (j, jp), c in entries.items():
+            outer, inner = (jp, j) if by_beta else (j, jp)
+            rows.setdefault(outer, {})[int(inner)] = c
+        for key, r in sorted(rows.items()):
+            lo, hi = min(r), max(r)
+            vals = [r.get(i, 0j) for i in range(lo, hi + 1)]
+            out[by_beta].append((float(lo), key, vals[-1], vals[-2::-1]) if by_beta
+                                else (key, float(lo), vals[-1], vals[-2::-1]))
+    by_beta = len(out[1]) < len(out[0])
+    return by_beta, out[by_beta]
+
+
+def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_lo: float,
+          du_hi: float, step0: float) -> SegmentEnd:
     """The end of rem (s) of rolling from ``w``'s start at the level K_s (J): Newton on
     t(u) = rem (t' = F on the path), then the impulse's sums at both ends."""
     sig, rho1 = w.sig, 1.0 + w.rho
     delta = 2.0 * w.T * sig / K_s
-    b_t = (1.0 - LEVEL_SHARE) * TOL_PHASE / (N_ORDERS * w.rho * tab.w_max)
-    b_d = (1.0 - LEVEL_SHARE) * TOL_IMPULSE * tab.d00_min * du_hi / N_ORDERS
-    # (the budgets of each degree n left out: time (s), t being twice the real part of its
-    # sum, and impulse (N s); du_hi bounds the step's u, its tolerance takes u >= du_lo)
-    sf = _StepSums(tab.F, -0.5, K_s, delta, du_hi, 0.5 * b_t)
+    b_t = ORDER_SHARE * TOL_PHASE / (2.0 * w.rho * tab.w_max)
+    b_d = ORDER_SHARE * TOL_IMPULSE * tab.d00_min * du_lo
+    # (the budgets of the orders left out: time (s), t being twice the real part of its
+    # sum, and impulse (N s), at the least u of the step)
+    sf = _StepSums(tab.F, -0.5, K_s, delta, du_hi, b_t)
     b_s = psi + w.phi - w.theta0
     s_t0 = sf.at(b_s, psi, 0.0)
     f00 = sf.mean[0]
