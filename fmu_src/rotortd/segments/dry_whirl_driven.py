@@ -24,17 +24,21 @@ Within a step K = K_s (1 + delta s), delta = 2 T sigma/K_s, and
     c_jl(s) = sum_n c_jl^n s^n,   c_jl^n = delta^n sum_k a_jlk K_s^(p0-k) C(p0 - k, n),
 
 so each harmonic is a polynomial in s times e^{i phi_jl(s)}, integrated in closed form
-(int_0^u P(s) e^{i omega s} ds = [Y(s) e^{i omega s}]_0^u, Y' + i omega Y = P, the backward
-recurrence of the Levin panel: omega = sigma w_jl, |w_jl| >= 1, and delta u <= 1e-2, so it
-does not amplify). Most harmonics need only n = 0; orders n >= 1 are kept for the largest
-harmonics while the rest integrate to within a share of the tolerance (``_orders``). A step
-is then Newton on these sums (as ``dry_whirl_orbit._solve``) and the impulse sums at both
-ends: its work follows the number of harmonics, which falls with the speed (eps = 2 V_b/K).
+(int_0^u P(s) e^{i omega s} ds = [Y(s) e^{i omega s}]_0^u, Y = sum_m (-1)^m P^(m)/(i omega)^(m+1),
+omega = sigma w_jl, |w_jl| >= 1). Summed over the harmonics this is sum_km w_km(u) S_km with
+fixed 2-D sums S_km = sum_jl a_jlk/(i omega)^(m+1) e^{i (j beta + l psi)} (``_Series``,
+built once per table) and scalar weights w_km(u), polynomials in u from K_s and delta
+(``_StepSums``): a step rebuilds no coefficient. It is Newton on these sums (as
+``dry_whirl_orbit._solve``) and the impulse sums at both ends: its work follows the number of
+terms, which falls with the speed (eps = 2 V_b/K). The table takes a step only where the
+panel's turn of theta is above TABLE_TURN: below it the direct panel of ``rolling_spin_fast``
+costs less (docs/notes/dry-whirl-quadrature.md §10).
 
 Errors (estimated, as ``dry_whirl_orbit``): the check harmonics (+-(K + 1)), the table terms
 left out (smallest first, TRIM_SHARE of the tolerance) and the orders k beyond the table's (the
 binomial tail, bounded by eps^(k+1)/(1 - eps)), each at its largest over the band, within
-LEVEL_SHARE of the step's tolerance; the orders n left out within ORDER_SHARE. Events:
+LEVEL_SHARE of the step's tolerance; the orders n left out within ORDER_SHARE, the Levin
+terms m >= 1 left out within M_SHARE. Events:
 ``DryWhirl._no_event`` over the whole torus and every Omega^2 the band allows, once per
 table. Where anything fails (the band's eps too large, an event not excluded, the step
 leaving the band, the bearing's spring on: a k != 0) ``advance`` declines and the panels of
@@ -71,12 +75,19 @@ from .dry_whirl_orbit import (
     _v_bound,
     segment_end,
 )
-from .rolling_spin_fast import BETA_DIRECT, SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
+from .rolling_spin_fast import SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
 
 if TYPE_CHECKING:
     from ..contact.wall import SegmentEnd
     from .spin_contact import HeldInputs
 
+TABLE_TURN = 2.0
+"""The table takes a step only where the panel's turn of theta (``DryWhirl.panel_length``
+times rho) is above this (rad): below it the direct panel costs less (measured,
+docs/notes/dry-whirl-quadrature.md §10); the Levin panel's steps (above BETA_DIRECT = 4
+rad) are all the table's."""
+FLAT_BELOW = 4
+"""A group of ``_Series`` with fewer terms is summed term by term, not by rows."""
 BAND_LOG2 = 0.25
 """Width of a band of levels K in log2 K: the table of band b serves K_s in
 [2^(b BAND_LOG2), 2^((b + 1) BAND_LOG2)), widened by WIDEN each way for the step's end."""
@@ -257,14 +268,16 @@ class LevelTable:
         hd, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
                              err_d, rho1, sig, top)
         delta_max = 2.0 * abs(w.T) / self.K_lo
-        self.du_min = 0.5 * BETA_DIRECT / w.rho * self.w_min / self.w_max
+        self.du_min = 0.5 * TABLE_TURN / w.rho * self.w_min / self.w_max
         tol_t = TOL_PHASE / (w.rho * self.w_max)  # (s: TOL_PHASE rad of theta)
         self.F = _Series(hf, m_f, f00, self.mean_f, -0.5, self.bf,
                          [max(K ** (-0.5 - k) for K in lo_hi) for k in range(len(self.bf))],
-                         delta_max, M_SHARE * tol_t / 4.0)  # (t: twice the real part, 2 ends)
+                         delta_max, (0.5 * M_SHARE * tol_t / 4.0,  # (t: 2 Re, 2 ends)
+                                     0.5 * M_SHARE * TOL_PHASE / (2.0 * self.w_max)))
         self.D = _Series(hd, m_d, d00, self.mean_d, 0.5, self.bd,
                          [max(K ** (0.5 - k) for K in lo_hi) for k in range(len(self.bd))],
-                         delta_max, M_SHARE * TOL_IMPULSE * self.d00_min * self.du_min / 2.0)
+                         delta_max, (0.5 * M_SHARE * TOL_IMPULSE * self.d00_min * self.du_min
+                                     / 2.0, 0.5 * M_SHARE * TOL_IMPULSE * self.d00_min))
         for (j, jp) in ((j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)):
             if abs(j) == k1 or abs(jp) == jp1:
                 _add(err_t, j, jp, 2.0 * top([c[(j, jp)] for c in cf], -0.5), rho1)
@@ -350,7 +363,7 @@ def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, re
     if not (rem > 0.0 and w.K0 > 0.0 and math.isfinite(w.K0)) or w.rho < RHO_MIN:
         return None, keep
     L = w.panel_length(rem)
-    if L is not None and w.rho * L <= BETA_DIRECT:
+    if L is not None and w.rho * L <= TABLE_TURN:
         return None, keep  # (the direct panel takes it, at less work: §10)
     K_s = w.K0 + 2.0 * (w.mge * w.sE0 - w.v0)  # I_P Omega^2 + 2 V_p at the start
     if not K_s > 0.0:
@@ -395,42 +408,58 @@ class _Series:
     scalar weights (``_StepSums``): no coefficient is rebuilt per step. m = 0 holds every
     kept term; m >= 1 the terms whose largest use over the band (m! (|delta| /|w|)^m of
     the m = 0 term, delta at most 2 |T|/K_lo, over 1 - ORDER_DELTA to the power m + 1) is
-    above what ``m_budget`` leaves out (smallest first; their sum is ``left``, an absolute
-    bound of the step's error in the sum at either end). Also the mean's a_00k and its
+    above what the budgets leave out, smallest first: ``budgets[0]`` for their value at
+    either end (an absolute bound B), ``budgets[1]`` for their change per radian of psi
+    (at most 2 |w| B: the sum's change over a step of du is at most that times du, for
+    tolerances that grow with du). Also the mean's a_00k and its
     magnitude over the band, the total magnitude of the harmonics, the binomials
     C(p0 - k, n) (row k) and their largest modulus per n. ``scale[k]``: the largest
     K^(p0 - k) over the band."""
 
-    __slots__ = ("bins", "cmax", "facs", "groups", "left", "m_top", "mean", "size", "total")
+    __slots__ = ("bins", "cmax", "facs", "flat", "groups", "left", "m_top", "mean", "size",
+                 "total")
 
     def __init__(self, hs: list[Harmonic], mags: list[float], mean: list[Any], size: float,
                  p0: float, bins: list[list[float]], scale: list[float], delta_max: float,
-                 m_budget: float) -> None:
+                 budgets: tuple[float, float]) -> None:
         self.mean, self.size, self.bins, self.total = mean, size, bins, sum(mags)
         self.cmax = [max(abs(row[n]) for row in bins) for n in range(N_ORDERS + 1)]
-        terms = []  # (bound of its use, m, k, j, l, coefficient)
+        terms = []  # (bound of its use, m, k, j, l, coefficient, 1/|w|)
         for j, jp, a, inv in hs:
             w_inv = abs(inv)
             for k, v in enumerate(a):
                 if not v:
                     continue
-                terms.append((0.0, 0, k, j, jp, v))
+                terms.append((0.0, 0, k, j, jp, v, w_inv))
                 use, c, m = abs(v) * scale[k], v, 0
                 while use > 0.0 and m < N_ORDERS:
                     m += 1  # (m! C(p0 - k, m) from (m - 1)! C(p0 - k, m - 1))
                     c *= inv
                     use *= abs(p0 - k - m + 1) * delta_max * w_inv / (1.0 - ORDER_DELTA)
-                    terms.append((use / (1.0 - ORDER_DELTA), m, k, j, jp, c))
-        self.left, kept = 0.0, []
+                    terms.append((use / (1.0 - ORDER_DELTA), m, k, j, jp, c, w_inv))
+        left, kept = [0.0, 0.0], []
         for t in sorted(terms, key=lambda t: t[0]):
-            if t[1] and self.left + t[0] <= m_budget:
-                self.left += t[0]
+            per_rad = 2.0 * t[0] / t[6]
+            if not t[1]:
+                kept.append(t)
+            elif left[0] + t[0] <= budgets[0]:
+                left[0] += t[0]
+            elif left[1] + per_rad <= budgets[1]:
+                left[1] += per_rad
             else:
                 kept.append(t)
+        self.left = tuple(left)
         by_group: dict[tuple[int, int], dict[tuple[float, float], complex]] = {}
-        for _, m, k, j, jp, c in kept:
+        for _, m, k, j, jp, c, _ in kept:
             by_group.setdefault((k, m), {})[(j, jp)] = c
-        self.groups = [(k, m, *_rows(entries)) for (k, m), entries in sorted(by_group.items())]
+        self.groups, self.flat = [], []
+        for (k, m), entries in sorted(by_group.items()):
+            if len(entries) < FLAT_BELOW:  # (a few terms: cheaper one by one than as rows)
+                gi = len(self.groups)
+                self.flat += [(j, jp, gi, c) for (j, jp), c in entries.items()]
+                self.groups.append((k, m, False, []))
+            else:
+                self.groups.append((k, m, *_rows(entries)))
         self.m_top = max(m for _, m, _, _ in self.groups)
         self.facs = [[(-1.0 if m % 2 else 1.0) * math.perm(q + m, m)
                       for q in range(N_ORDERS + 1)] for _, m, _, _ in self.groups]
@@ -443,7 +472,7 @@ class _StepSums:
     Y = sum_m (-1)^m P^(m)/(i w)^(m+1), P(s) = sum_n c^n s^n, c^n = sum_k a_k W_nk,
     W_nk = delta^n K_s^(p0-k) C(p0 - k, n)), and the mean's integral."""
 
-    __slots__ = ("items", "mean")
+    __slots__ = ("flat", "items", "mean")
 
     def __init__(self, ser: _Series, p0: float, K_s: float, delta: float, u_hi: float,
                  budget: float) -> None:
@@ -463,18 +492,24 @@ class _StepSums:
         self.items = [([fac[q] * Wn[q + m][k] for q in qs], by_beta, rows)
                       for (k, m, by_beta, rows), fac in zip(ser.groups, ser.facs)]
         """Each group's weight as a polynomial in u (its coefficients, highest first), its
-        rows' orientation and its rows."""
+        rows' orientation and its rows (none: its terms are in ``flat``)."""
+        self.flat = ser.flat
 
     def at(self, beta: float, psi: float, u: float) -> complex:
         """sum_km w_km(u) S_km(beta, psi): the periodic part's Levin sum at (beta, psi) (rad)
         reached after u (rad)."""
         zs = (cmath.rect(1.0, psi), cmath.rect(1.0, beta))
         s = 0j
+        ws = []
         for poly, by_beta, rows in self.items:
             w = 0.0
             for c in poly:
                 w = w * u + c
-            s += w * _series(rows, beta, psi, zs[by_beta])
+            ws.append(w)
+            if rows:
+                s += w * _series(rows, beta, psi, zs[by_beta])
+        for j, jp, gi, c in self.flat:
+            s += ws[gi] * c * cmath.rect(1.0, j * beta + jp * psi)
         return s
 
     def integral(self, u: float) -> Any:
