@@ -2,6 +2,7 @@
 
     python docs/scripts/bench_dry_whirl_speed.py              # ~5 min (callgrind + mpmath)
     python docs/scripts/bench_dry_whirl_speed.py --no-errors  # instructions only
+    python docs/scripts/bench_dry_whirl_speed.py --quick driven 60,200,600,2000 --torque 30
 
 Issue #26 item 1 (docs/notes/dry-whirl-quadrature.md). The chapter's rotor (g = 9.81,
 J = m R^2/2 = 0.04 kg m^2, ``integrate_spin``: ``SpinCore``) rolls on the fixed race at
@@ -94,7 +95,7 @@ a = 1.0 if kind == "damper" else 0.0
 for _ in range(WARM + n):
     core.step(H, amb_on=a, T_drive=T)
 assert core.mode == 2, (kind, W, core.mode)
-'''.replace("WARM", str(WARM)).replace("H,", f"{H!r},").replace("TDRIVE", repr(T_DRIVE))
+'''.replace("WARM", str(WARM)).replace("H,", f"{H!r},")
 
 
 def sanity(W: float, kind: str) -> tuple[int, int]:
@@ -169,7 +170,7 @@ def count(speeds: tuple[float, ...] = SPEEDS, kinds: tuple[str, ...] = KINDS
     out: dict[str, dict[str, float]] = {k: {} for k in kinds}
     with tempfile.TemporaryDirectory() as tmp:
         script = Path(tmp) / "child.py"
-        script.write_text(CHILD)
+        script.write_text(CHILD.replace("TDRIVE", repr(T_DRIVE)))
         src = str(ROOT / "fmu_src")
         for W in speeds:
             for kind in kinds:
@@ -260,6 +261,8 @@ def main() -> int:
     ap.add_argument("--no-errors", action="store_true")
     ap.add_argument("--quick", nargs=2, metavar=("KINDS", "SPEEDS"),
                     help="count only these (comma-separated), print, write nothing")
+    ap.add_argument("--torque", type=float, metavar="T",
+                    help="with --quick: the driven kinds' T_drive (N m) in place of T_DRIVE")
     ap.add_argument("--floor-only", action="store_true",
                     help="only the floor FMU's step (3.), into the existing file, ~2 min")
     args = ap.parse_args()
@@ -271,6 +274,8 @@ def main() -> int:
         print(f"wrote {OUT.relative_to(ROOT)}")
         return 0
     if args.quick:
+        global T_DRIVE
+        T_DRIVE = T_DRIVE if args.torque is None else args.torque
         count(tuple(float(w) for w in args.quick[1].split(",")),
               tuple(args.quick[0].split(",")))
         return 0

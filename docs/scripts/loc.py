@@ -46,7 +46,8 @@ GROUPS: dict[str, tuple[str, ...]] = {
         "bodies/race.py", "contact/laws.py", "segments/bearing_contact.py",
         "step/bearing_step.py"),
     "issue 26, the speed accelerators (none of them at e272741)": (
-        "segments/dry_whirl_orbit.py", "segments/rolling_spin_fast.py",
+        "segments/dry_whirl_orbit.py", "segments/dry_whirl_driven.py",
+        "segments/rolling_spin_fast.py",
         "step/flight_step.py::quiet_step", "step/flight_step.py::quiet_lane",
         "step/flight_step.py::QuietLane", "step/flight_step.py::make_quiet_lane",
         "segments/spin_flight.py::_run_quiet", "segments/spin_flight.py::short_taylor",

@@ -291,6 +291,17 @@ MUTANTS: tuple[Mutant, ...] = (
       "rolling step was refused by it (the build charged twice, the map built early)",
       "        st.orbit_asked = asked", "        st.orbit_asked = False",
       ("tests/test_dry_whirl_orbit.py",)),
+    # ---------------------------------------------------------------- dry whirl level table (#26)
+    M("DW1", "dry whirl level table", "the level held at the step's start (the orders n >= 1 "
+      "of the level's polynomial in s dropped)",
+      "            return n - 1", "            return 0", ("tests/test_dry_whirl_driven.py",)),
+    M("DW2", "dry whirl level table", "the Levin terms m >= 1 all of one sign",
+      "(-1.0 if m % 2 else 1.0) * math.perm(q + m, m)", "1.0 * math.perm(q + m, m)",
+      ("tests/test_dry_whirl_driven.py",)),
+    M("DW3", "dry whirl level table", "the table also at the direct panel's steps (a turn "
+      "of theta below TABLE_TURN)",
+      "    if L is not None and w.rho * L <= TABLE_TURN:",
+      "    if L is not None and w.rho * L <= -1.0:", ("tests/test_dry_whirl_driven.py",)),
 )
 
 
