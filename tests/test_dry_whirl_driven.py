@@ -127,6 +127,25 @@ def test_the_core_keeps_the_table_and_replays_from_a_state() -> None:
     assert again.get_state() == core.get_state() and rerun == run
 
 
+def test_a_torque_that_changes_every_step_keeps_its_table() -> None:
+    """A speed controller sets T_drive every step: within a factor 2 (``torque_cap``) the
+    table serves them all (D's part linear in T_drive held apart), each step as accurate
+    as with its own table."""
+    core = _rolling_core(2000.0)
+    tables = set()
+    for k in range(12):
+        core.step(H, amb_on=0.0, T_drive=24.0 + 7.0 * math.sin(k))  # (17 to 31 N m)
+        tables.add(id(core._orbit))
+    assert core.mode == 2 and len(tables) == 1 and isinstance(core._orbit, LevelTable)
+    tab, th, psi, W = core._orbit, core.state.theta, core.state.psi, core.state.Omega
+    for T in (17.0, -31.0, 2.0 ** -3):
+        h = _driven(T)
+        new, again = _advance(h, th, psi, W, H, tab)
+        assert new is not None and (again is tab) == (T != 2.0 ** -3)
+        err = errors_against_the_integrator(h, th, psi, W, new)
+        assert all(v <= TOL for v in err.values()), (T, err)
+
+
 def test_consecutive_steps_agree_with_the_integrator() -> None:
     """Five steps on one table, each from the previous one's end, against the integrator
     from the same starts (the errors do not grow with the steps taken on a table)."""

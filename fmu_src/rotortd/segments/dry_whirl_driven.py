@@ -54,6 +54,7 @@ from __future__ import annotations
 
 import cmath
 import math
+from dataclasses import replace
 from operator import mul
 from typing import TYPE_CHECKING, Any
 
@@ -116,8 +117,11 @@ N_ORDERS = 10
 |delta| u, is then at most ORDER_DELTA)."""
 ORDER_DELTA = 0.01
 """Largest relative change of the level over a step taken here."""
-TABLE_WORK = SAMPLE_WORK * N_BETA * N_PSI * 4
-"""The most work (units) a table's build takes (two samples of the forces at each grid
+T_PROBE = 2.0 ** 30
+"""The drive torque (N m) at which the rolling forces are sampled a second time for their
+part linear in T_drive: large, so that the difference is not lost to the rounding of N."""
+TABLE_WORK = SAMPLE_WORK * N_BETA * N_PSI * 6
+"""The most work (units) a table's build takes (three samples of the forces at each grid
 point and the DFTs); it is built only where the step's work limit covers this."""
 STEP_WORK = SAMPLE_WORK * (2 * NEWTON_ITERS + 5)
 """The work (units) charged for a step (as ``dry_whirl_orbit``'s)."""
@@ -155,23 +159,36 @@ def band_of(K: float) -> int:
     return math.floor(math.log2(K) / BAND_LOG2)
 
 
+def torque_cap(T: float) -> float:
+    """The bound of |T_drive| (N m) a table serves: the power of 2 at or above |T|, so that a
+    drive torque that changes every step (a speed controller's) keeps its table while it
+    stays within a factor 2 (the table holds D's part linear in T_drive apart,
+    ``LevelTable``)."""
+    return 2.0 ** math.ceil(math.log2(abs(T)))
+
+
 def level_key(h: HeldInputs, Omega: float) -> Key:
-    """What a table depends on besides the band: the rotor, the held inputs and the spin's
-    direction."""
-    return (h.p, h.J, h.a, h.F_ext, h.T_drive, Omega >= 0.0)
+    """What a table depends on besides the band: the rotor, the held inputs (the drive
+    torque through ``torque_cap``) and the spin's direction."""
+    return (h.p, h.J, h.a, h.F_ext, torque_cap(h.T_drive), Omega >= 0.0)
 
 
 class LevelTable:
     """The table a_jlk of F and D (module docstring) for ``key`` and the band ``band`` of
     levels; ``ok`` False where it cannot serve (eps too large, an event not excluded, the
-    series do not converge within the tolerance)."""
+    series do not converge within the tolerance). D = D0 + T_drive D_T: the drive torque
+    enters the rolling forces additively (N + i F_t gains T m (B + i A)/I_P), so the table
+    holds D0 (at T_drive = 0) and cap D_T apart and serves every |T_drive| up to the key's
+    cap (``torque_cap``); its bounds (events, the level's rate, Newton's) take the cap."""
 
-    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "bd", "bf", "d00_min", "d_scale", "du_min",
-                 "err_d", "err_t", "k_max", "kappa", "key", "mean_d", "mean_f", "n_rising",
-                 "n_rows", "ok", "w_max", "w_min")
+    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "bd", "bf", "cap", "d00_min",
+                 "d_scale", "du_min", "err_d", "err_t", "k_max", "kappa", "key", "mean_d",
+                 "mean_f", "n_rising", "n_rows", "ok", "w_max", "w_min")
 
     def __init__(self, w: DryWhirl, key: Key, band: int) -> None:
         self.key, self.band, self.ok = key, band, False
+        self.cap = key[4]
+        w = _with_torque(w, self.cap)  # (the bounds at the largest torque served)
         self.K_lo = 2.0 ** (band * BAND_LOG2) / WIDEN
         self.K_hi = 2.0 ** ((band + 1) * BAND_LOG2) * WIDEN
         vb = _v_bound(w)
@@ -190,34 +207,41 @@ class LevelTable:
         if tail > LEVEL_TAIL:
             return
         self.k_max = k_max
-        fs, ds = self._grid(w, k_max)
+        fs, ds, dts = self._grid(w, k_max)
         self.bf, self.bd = _binomials(-0.5, k_max), _binomials(0.5, k_max + 1)
-        self._tables(w, [_dft2(x) for x in fs], [_dft2(x) for x in ds], tail)
+        self._tables(w, [_dft2(x) for x in fs], [_dft2(x) for x in ds],
+                     [_dft2(x) for x in dts], tail)
 
     def _grid(self, w: DryWhirl, k_max: int
-              ) -> tuple[list[list[list[float]]], list[list[list[complex]]]]:
+              ) -> tuple[list[list[list[float]]], list[list[list[complex]]],
+                         list[list[list[complex]]]]:
         """The table's functions on the orbit's grid, fs[k][a][b] = sqrt(I_P) b_k (2 V_p)^k
         (k <= k_max) and ds[k][a][b] = Q1 b'_k (2 V_p)^k/sqrt(I_P) + Q0 sqrt(I_P) b_(k-1)
         (2 V_p)^(k-1) (D's part of order K^(1/2 - k), k <= k_max + 1, so that both of its
-        binomial tails start beyond k_max), at (beta_a, psi_b); the rows of N = alpha +
-        gamma K (``peak_on``) and d_scale >= |Q0| F + |Q1|/F over the band. Q0, Q1 from
-        the rolling forces of ``DryWhirl.beta_row`` at two levels (N + i F_t is linear in
-        Omega^2)."""
+        binomial tails start beyond k_max) with Q0 at T_drive = 0, dts[k][a][b] the same of
+        cap G (G = dQ0/dT_drive), at (beta_a, psi_b); the rows of N = alpha0 + T alpha_T +
+        gamma K (``peak_on``) and d_scale >= (|Q0| + cap |G|) F + |Q1|/F over the band. Q0,
+        Q1 and G from the rolling forces of ``DryWhirl.beta_row`` at two levels (N + i F_t
+        is linear in Omega^2) and at a large probe torque (and linear in T_drive)."""
         grid = w.beta_grid(_CB, _SB)
         bF, bR = _series_b(False, k_max + 1), _series_b(True, k_max + 1)
         K_a = 4.0 * _v_bound(w) + 1e-3 * self.K_lo  # (Omega^2 small: Q0 from it is not
         K_b = self.K_hi                              # a difference of large values)
         fs = [[[0.0] * N_PSI for _ in range(N_BETA)] for _ in range(k_max + 1)]
         ds = [[[0j] * N_PSI for _ in range(N_BETA)] for _ in range(k_max + 2)]
+        dts = [[[0j] * N_PSI for _ in range(N_BETA)] for _ in range(k_max + 2)]
         self.d_scale = 0.0
-        self.n_rows: list[tuple[list[float], list[float]]] = []
+        self.n_rows: list[tuple[list[float], list[float], list[float]]] = []
+        w0, wp = _with_torque(w, 0.0), _with_torque(w, T_PROBE)
+        cap = self.cap
         c_r, Gx, Gy, mge = w.c_r, w.Gx, w.Gy, w.mge
         for b in range(N_PSI):
             ang = 2.0 * math.pi * b / N_PSI + w.phi
             cE, sE = math.cos(ang), math.sin(ang)
-            _, d_a, _ = w.beta_row(grid, cE, sE, K_a - 2.0 * mge * sE)
-            _, d_b, _ = w.beta_row(grid, cE, sE, K_b - 2.0 * mge * sE)
-            alphas, gammas = [], []
+            _, d_a, _ = w0.beta_row(grid, cE, sE, K_a - 2.0 * mge * sE)
+            _, d_b, _ = w0.beta_row(grid, cE, sE, K_b - 2.0 * mge * sE)
+            _, d_p, _ = wp.beta_row(grid, cE, sE, K_a - 2.0 * mge * sE)
+            alphas, alphas_t, gammas = [], [], []
             for a, (cb, sb, IP) in enumerate(zip(grid[0], grid[1], grid[2])):
                 ct, st = cE * cb + sE * sb, sE * cb - cE * sb
                 v2 = 2.0 * (mge * sE - c_r * (Gx * ct + Gy * st))  # 2 V_p
@@ -225,11 +249,13 @@ class LevelTable:
                 z_a, z_b = d_a[a] * math.sqrt(om_a), d_b[a] * math.sqrt(om_b)  # N + i F_t
                 q1 = (z_b - z_a) / (om_b - om_a)
                 q0 = z_a - q1 * om_a
+                g = (d_p[a] * math.sqrt(om_a) - z_a) / T_PROBE
                 alphas.append(q0.real - q1.real * v2 / IP)
+                alphas_t.append(g.real)
                 gammas.append(q1.real / IP)
                 sq = math.sqrt(IP)
                 self.d_scale = max(self.d_scale,
-                                   abs(q0) * math.sqrt(IP / (self.K_lo - v2))
+                                   (abs(q0) + cap * abs(g)) * math.sqrt(IP / (self.K_lo - v2))
                                    + abs(q1) * math.sqrt((self.K_hi - v2) / IP))
                 x, x_prev = 1.0, 0.0
                 for k in range(k_max + 2):
@@ -237,15 +263,17 @@ class LevelTable:
                         fs[k][a][b] = sq * bF[k] * x
                     ds[k][a][b] = q1 / sq * bR[k] * x + (q0 * sq * bF[k - 1] * x_prev
                                                          if k else 0j)
+                    dts[k][a][b] = cap * g * sq * bF[k - 1] * x_prev if k else 0j
                     x, x_prev = x * v2, x
-            self.n_rows.append((alphas, gammas))
-        self.n_rising = all(g >= 0.0 for _, ga in self.n_rows for g in ga)
+            self.n_rows.append((alphas, alphas_t, gammas))
+        self.n_rising = all(g >= 0.0 for _, _, ga in self.n_rows for g in ga)
         """N grows with K at every point of the grid (the centripetal term): the peak over
         a step's levels is at the larger."""
-        return fs, ds
+        return fs, ds, dts
 
     def _tables(self, w: DryWhirl, cf: list[dict[tuple[int, int], complex]],
-                cd: list[dict[tuple[int, int], complex]], tail: float) -> None:
+                cd: list[dict[tuple[int, int], complex]],
+                ct: list[dict[tuple[int, int], complex]], tail: float) -> None:
         """The harmonics kept (``Harmonic``), their magnitude bounds over the band sorted
         largest first (for ``_orders``), the means and the error bounds."""
         rho1, sig = 1.0 + w.rho, w.sig
@@ -256,9 +284,11 @@ class LevelTable:
 
         f00 = [c[(0, 0)].real for c in cf]
         d00 = [c[(0, 0)] for c in cd]
+        t00 = [c[(0, 0)] for c in ct]
         f_min = min(sum(v * K ** (-0.5 - k) for k, v in enumerate(f00)) for K in lo_hi)
         self.d00_min = min(abs(sum(v * K ** (0.5 - k) for k, v in enumerate(d00)))
-                           for K in lo_hi)
+                           - abs(sum(v * K ** (0.5 - k) for k, v in enumerate(t00)))
+                           for K in lo_hi)  # (|D0_00 + T D_T,00| for |T| <= cap)
         self.mean_f, self.mean_d = top(f00, -0.5), top(d00, 0.5)
         k1, jp1 = K_BETA + 1, K_PSI + 1
         err_t = [0.0, 0.0, tail * self.mean_f]  # (the binomial tail: slow)
@@ -267,21 +297,28 @@ class LevelTable:
                              rho1, sig, top)
         hd, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
                              err_d, rho1, sig, top)
+        ht, m_t = self._kept(ct, 0.5, False, 0.5 * TRIM_SHARE * TOL_IMPULSE * self.d00_min,
+                             err_d, rho1, sig, top)
         delta_max = 2.0 * abs(w.T) / self.K_lo
         self.du_min = 0.5 * TABLE_TURN / w.rho * self.w_min / self.w_max
         tol_t = TOL_PHASE / (w.rho * self.w_max)  # (s: TOL_PHASE rad of theta)
-        self.F = _Series(hf, m_f, f00, self.mean_f, -0.5, self.bf,
+        self.F = _Series((hf, m_f, f00, self.mean_f,
+                          (0.5 * M_SHARE * tol_t / 4.0,  # (t: 2 Re, 2 ends)
+                           0.5 * M_SHARE * TOL_PHASE / (2.0 * self.w_max))),
+                         -0.5, self.bf,
                          [max(K ** (-0.5 - k) for K in lo_hi) for k in range(len(self.bf))],
-                         delta_max, (0.5 * M_SHARE * tol_t / 4.0,  # (t: 2 Re, 2 ends)
-                                     0.5 * M_SHARE * TOL_PHASE / (2.0 * self.w_max)))
-        self.D = _Series(hd, m_d, d00, self.mean_d, 0.5, self.bd,
-                         [max(K ** (0.5 - k) for K in lo_hi) for k in range(len(self.bd))],
-                         delta_max, (0.5 * M_SHARE * TOL_IMPULSE * self.d00_min * self.du_min
-                                     / 2.0, 0.5 * M_SHARE * TOL_IMPULSE * self.d00_min))
+                         delta_max)
+        scale_d = [max(K ** (0.5 - k) for K in lo_hi) for k in range(len(self.bd))]
+        budgets_d = (0.5 * M_SHARE * TOL_IMPULSE * self.d00_min * self.du_min / 2.0,
+                     0.5 * M_SHARE * TOL_IMPULSE * self.d00_min)
+        self.D = _Series((hd, m_d, d00, self.mean_d, budgets_d), 0.5, self.bd, scale_d,
+                         delta_max, (ht, m_t, t00, top(t00, 0.5),
+                                     (0.5 * budgets_d[0], 0.5 * budgets_d[1])))
         for (j, jp) in ((j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)):
             if abs(j) == k1 or abs(jp) == jp1:
                 _add(err_t, j, jp, 2.0 * top([c[(j, jp)] for c in cf], -0.5), rho1)
-                _add(err_d, j, jp, 2.0 * top([c[(j, jp)] for c in cd], 0.5), rho1)
+                _add(err_d, j, jp, 2.0 * top([c[(j, jp)] for c in cd], 0.5)
+                     + 2.0 * top([c[(j, jp)] for c in ct], 0.5), rho1)
         self.err_t, self.err_d = tuple(err_t), tuple(err_d)
         self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
                             + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge)
@@ -325,20 +362,27 @@ class LevelTable:
         out.sort(key=lambda e: -e[0])
         return [h for _, h in out], [m for m, _ in out]
 
-    def peak_on(self, psi_a: float, psi_b: float, K_a: float, K_b: float) -> float:
+    def peak_on(self, psi_a: float, psi_b: float, K_a: float, K_b: float, T: float
+                ) -> float:
         """The largest |N| (N) on the beta grid of the rows of the grid within [psi_a,
         psi_b] (either order) widened by one row each way, at the levels K_a and K_b (N is
-        linear in K at each point): as ``Orbit.peak_on``."""
+        linear in K at each point) and the drive torque T (N m): as ``Orbit.peak_on``."""
         lo, hi = min(psi_a, psi_b), max(psi_a, psi_b)
         k0 = math.floor(lo * N_PSI / (2.0 * math.pi))
         k1 = min(math.floor(hi * N_PSI / (2.0 * math.pi)) + 1, k0 + N_PSI - 1)
         out = 0.0
         levels = (max(K_a, K_b),) if self.n_rising else (K_a, K_b)
         for k in range(k0, k1 + 1):
-            al, ga = self.n_rows[k % N_PSI]
+            al, at, ga = self.n_rows[k % N_PSI]
             for K in levels:  # (N > 0 over the band, _no_event: |N| = N)
-                out = max(out, max([a + g * K for a, g in zip(al, ga)]))
+                out = max(out, max([a + T * b + g * K for a, b, g in zip(al, at, ga)]))
         return out
+
+
+def _with_torque(w: DryWhirl, T: float) -> DryWhirl:
+    """A copy of ``w`` with the drive torque T (N m) in place of its own (the forces, the
+    event bounds and the rates read ``w.T``)."""
+    return DryWhirl(replace(w.h, T_drive=T), w.theta0, w.psi0, w.Omega0)
 
 
 def _add(err: list[float], j: int, jp: int, size: float, rho1: float) -> None:
@@ -416,54 +460,72 @@ class _Series:
     C(p0 - k, n) (row k) and their largest modulus per n. ``scale[k]``: the largest
     K^(p0 - k) over the band."""
 
-    __slots__ = ("bins", "cmax", "facs", "flat", "groups", "left", "m_top", "mean", "size",
-                 "total")
+    __slots__ = ("bins", "cmax", "facs", "flat", "groups", "left", "m_top", "mean", "mean_t",
+                 "size", "total")
 
-    def __init__(self, hs: list[Harmonic], mags: list[float], mean: list[Any], size: float,
-                 p0: float, bins: list[list[float]], scale: list[float], delta_max: float,
-                 budgets: tuple[float, float]) -> None:
-        self.mean, self.size, self.bins, self.total = mean, size, bins, sum(mags)
+    def __init__(self, part: Part, p0: float, bins: list[list[float]], scale: list[float],
+                 delta_max: float, part_t: Part | None = None) -> None:
+        parts = [part] if part_t is None else [part, part_t]
+        self.mean = part[2]
+        self.mean_t = None if part_t is None else part_t[2]
+        self.size = sum(p[3] for p in parts)
+        self.bins, self.total = bins, sum(sum(p[1]) for p in parts)
         self.cmax = [max(abs(row[n]) for row in bins) for n in range(N_ORDERS + 1)]
-        terms = []  # (bound of its use, m, k, j, l, coefficient, 1/|w|)
-        for j, jp, a, inv in hs:
-            w_inv = abs(inv)
-            for k, v in enumerate(a):
-                if not v:
-                    continue
-                terms.append((0.0, 0, k, j, jp, v, w_inv))
-                use, c, m = abs(v) * scale[k], v, 0
-                while use > 0.0 and m < N_ORDERS:
-                    m += 1  # (m! C(p0 - k, m) from (m - 1)! C(p0 - k, m - 1))
-                    c *= inv
-                    use *= abs(p0 - k - m + 1) * delta_max * w_inv / (1.0 - ORDER_DELTA)
-                    terms.append((use / (1.0 - ORDER_DELTA), m, k, j, jp, c, w_inv))
-        left, kept = [0.0, 0.0], []
-        for t in sorted(terms, key=lambda t: t[0]):
-            per_rad = 2.0 * t[0] / t[6]
-            if not t[1]:
-                kept.append(t)
-            elif left[0] + t[0] <= budgets[0]:
-                left[0] += t[0]
-            elif left[1] + per_rad <= budgets[1]:
-                left[1] += per_rad
-            else:
-                kept.append(t)
-        self.left = tuple(left)
-        by_group: dict[tuple[int, int], dict[tuple[float, float], complex]] = {}
-        for _, m, k, j, jp, c, _ in kept:
-            by_group.setdefault((k, m), {})[(j, jp)] = c
+        kept, self.left = [], []
+        for f, (hs, _, _, _, budgets) in enumerate(parts):
+            left = [0.0, 0.0]
+            for t in sorted(_terms(hs, p0, scale, delta_max), key=lambda t: t[0]):
+                per_rad = 2.0 * t[0] / t[6]
+                if not t[1]:
+                    kept.append((f, *t))
+                elif left[0] + t[0] <= budgets[0]:
+                    left[0] += t[0]
+                elif left[1] + per_rad <= budgets[1]:
+                    left[1] += per_rad
+                else:
+                    kept.append((f, *t))
+            self.left.append(tuple(left))
+        by_group: dict[tuple[int, int, int], dict[tuple[float, float], complex]] = {}
+        for f, _, m, k, j, jp, c, _ in kept:
+            by_group.setdefault((k, m, f), {})[(j, jp)] = c
         self.groups, self.flat = [], []
-        for (k, m), entries in sorted(by_group.items()):
+        for (k, m, f), entries in sorted(by_group.items()):
             if len(entries) < FLAT_BELOW:  # (a few terms: cheaper one by one than as rows)
                 gi = len(self.groups)
                 self.flat += [(j, jp, gi, c) for (j, jp), c in entries.items()]
-                self.groups.append((k, m, False, []))
+                self.groups.append((k, m, f, False, []))
             else:
-                self.groups.append((k, m, *_rows(entries)))
-        self.m_top = max(m for _, m, _, _ in self.groups)
-        self.facs = [[(-1.0 if m % 2 else 1.0) * math.perm(q + m, m)
-                      for q in range(N_ORDERS + 1)] for _, m, _, _ in self.groups]
+                self.groups.append((k, m, f, *_rows(entries)))
+        self.m_top = max(g[1] for g in self.groups)
+        self.facs = [[(-1.0 if g[1] % 2 else 1.0) * math.perm(q + g[1], g[1])
+                      for q in range(N_ORDERS + 1)] for g in self.groups]
         """(-1)^m (q + m)!/q! of each group (``_StepSums``'s weights)."""
+
+
+Part = tuple[list[Harmonic], list[float], list[Any], float, tuple[float, float]]
+"""One part of a ``_Series``: its harmonics, their magnitudes, the mean's a_00k, the
+mean's magnitude, and the budgets of its Levin terms m >= 1 left out (at the ends, per
+radian)."""
+
+
+def _terms(hs: list[Harmonic], p0: float, scale: list[float], delta_max: float
+           ) -> list[tuple[float, int, int, float, float, complex, float]]:
+    """Every term (bound of its use, m, k, j, l, coefficient a_jlk/(i w)^(m+1), 1/|w|) of
+    the harmonics hs: m = 0, and m >= 1 while its bound is positive (``_Series``)."""
+    terms = []
+    for j, jp, a, inv in hs:
+        w_inv = abs(inv)
+        for k, v in enumerate(a):
+            if not v:
+                continue
+            terms.append((0.0, 0, k, j, jp, v, w_inv))
+            use, c, m = abs(v) * scale[k], v, 0
+            while use > 0.0 and m < N_ORDERS:
+                m += 1  # (m! C(p0 - k, m) from (m - 1)! C(p0 - k, m - 1))
+                c *= inv
+                use *= abs(p0 - k - m + 1) * delta_max * w_inv / (1.0 - ORDER_DELTA)
+                terms.append((use / (1.0 - ORDER_DELTA), m, k, j, jp, c, w_inv))
+    return terms
 
 
 class _StepSums:
@@ -475,7 +537,7 @@ class _StepSums:
     __slots__ = ("flat", "items", "mean")
 
     def __init__(self, ser: _Series, p0: float, K_s: float, delta: float, u_hi: float,
-                 budget: float) -> None:
+                 budget: float, gain: float = 0.0) -> None:
         bins = ser.bins
         P = [K_s ** p0]
         r = 1.0 / K_s
@@ -488,9 +550,13 @@ class _StepSums:
             dn *= delta
             Wn.append([pk * row[n] * dn for pk, row in zip(P, bins)])
         self.mean = [sum(map(mul, ser.mean, Wn[n])) / (n + 1) for n in range(n_top + 1)]
+        if ser.mean_t is not None:  # (D's part linear in T_drive, times gain = T/cap)
+            self.mean = [c + gain * sum(map(mul, ser.mean_t, Wn[n])) / (n + 1)
+                         for n, c in enumerate(self.mean)]
         qs = range(n_top, -1, -1)
-        self.items = [([fac[q] * Wn[q + m][k] for q in qs], by_beta, rows)
-                      for (k, m, by_beta, rows), fac in zip(ser.groups, ser.facs)]
+        gains = (1.0, gain)
+        self.items = [([gains[f] * fac[q] * Wn[q + m][k] for q in qs], by_beta, rows)
+                      for (k, m, f, by_beta, rows), fac in zip(ser.groups, ser.facs)]
         """Each group's weight as a polynomial in u (its coefficients, highest first), its
         rows' orientation and its rows (none: its terms are in ``flat``)."""
         self.flat = ser.flat
@@ -587,12 +653,12 @@ def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_l
         if tab.kappa * du * du <= math.ulp(u_lin + x):
             break
     u = u_lin + x
-    sd = _StepSums(tab.D, 0.5, K_s, delta, du_hi, b_d)
+    sd = _StepSums(tab.D, 0.5, K_s, delta, du_hi, b_d, w.T / tab.cap)
     b_e, p_e = b_s + rho1 * sig * u, psi + sig * u
     P = sd.integral(u) + sd.at(b_e, p_e, u) - sd.at(b_s, psi, 0.0)
     K_e = K_s + 2.0 * w.T * sig * u
 
     def peak_on(psi_a: float, psi_b: float) -> float:
-        return tab.peak_on(psi_a, psi_b, K_s, K_e)
+        return tab.peak_on(psi_a, psi_b, K_s, K_e, w.T)
 
     return segment_end(w, psi, rem, u, P, 0j, peak_on, STEP_WORK, step0, tab)
