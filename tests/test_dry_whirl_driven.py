@@ -170,3 +170,6 @@ def test_declines_where_it_must() -> None:
     assert slow is None and not tab.ok  # 2 V_b/K near 0.08, above EPS_MAX
     assert _advance(_driven(1.0), TH0, PSI0, 2000.0, H, limit=driven.TABLE_WORK - 1) == (
         None, None)
+    for T in (1e308, -1e308, 5e-324):  # (the level's change too large; a subnormal torque)
+        end, _ = _advance(_driven(T), TH0, PSI0, 2000.0, H)
+        assert (end is None) == (abs(T) > 1.0)

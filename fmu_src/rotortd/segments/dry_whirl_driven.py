@@ -163,8 +163,9 @@ def torque_cap(T: float) -> float:
     """The bound of |T_drive| (N m) a table serves: the power of 2 at or above |T|, so that a
     drive torque that changes every step (a speed controller's) keeps its table while it
     stays within a factor 2 (the table holds D's part linear in T_drive apart,
-    ``LevelTable``)."""
-    return 2.0 ** math.ceil(math.log2(abs(T)))
+    ``LevelTable``); |T| itself beyond 2^1000 (no float is the power of 2 above it)."""
+    e = math.ceil(math.log2(abs(T)))
+    return 2.0 ** e if e <= 1000 else abs(T)
 
 
 def level_key(h: HeldInputs, Omega: float) -> Key:
