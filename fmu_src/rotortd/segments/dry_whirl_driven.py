@@ -453,13 +453,13 @@ class _Series:
     scalar weights (``_StepSums``): no coefficient is rebuilt per step. m = 0 holds every
     kept term; m >= 1 the terms whose largest use over the band (m! (|delta| /|w|)^m of
     the m = 0 term, delta at most 2 |T|/K_lo, over 1 - ORDER_DELTA to the power m + 1) is
-    above what the budgets leave out, smallest first: ``budgets[0]`` for their value at
-    either end (an absolute bound B), ``budgets[1]`` for their change per radian of psi
-    (at most 2 |w| B: the sum's change over a step of du is at most that times du, for
-    tolerances that grow with du). Also the mean's a_00k and its
-    magnitude over the band, the total magnitude of the harmonics, the binomials
-    C(p0 - k, n) (row k) and their largest modulus per n. ``scale[k]``: the largest
-    K^(p0 - k) over the band."""
+    above what the part's budgets leave out, smallest first (``Part``): the first for their
+    value at either end (an absolute bound B), the second for their change per radian of
+    psi (at most 2 |w| B: the sum's change over a step of du is at most that times du, for
+    tolerances that grow with du). ``part_t``: D's part linear in T_drive (cap D_T), its
+    groups weighted by T/cap per step. Also the means' a_00k and magnitudes, the total
+    magnitude of the harmonics, the binomials C(p0 - k, n) (row k) and their largest
+    modulus per n. ``scale[k]``: the largest K^(p0 - k) over the band."""
 
     __slots__ = ("bins", "cmax", "facs", "flat", "groups", "left", "m_top", "mean", "mean_t",
                  "size", "total")
@@ -533,7 +533,9 @@ class _StepSums:
     """A ``_Series`` at a step's start level K_s (J), delta = 2 T sigma/K_s: each group's
     weight as a polynomial in u (Levin: int_0^u P(s) e^{i w s} ds = [Y(s) e^{i w s}],
     Y = sum_m (-1)^m P^(m)/(i w)^(m+1), P(s) = sum_n c^n s^n, c^n = sum_k a_k W_nk,
-    W_nk = delta^n K_s^(p0-k) C(p0 - k, n)), and the mean's integral."""
+    W_nk = delta^n K_s^(p0-k) C(p0 - k, n)), and the mean's integral. ``gain`` = T/cap
+    weights the series' part linear in T_drive; ``budget`` bounds the orders n left out
+    (``_orders``) over a step of at most u_hi rad."""
 
     __slots__ = ("flat", "items", "mean")
 
