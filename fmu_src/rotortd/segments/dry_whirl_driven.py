@@ -73,7 +73,9 @@ from .dry_whirl_orbit import (
     _dft2,
     _i_min,
     _series,
+    _trimmed,
     _v_bound,
+    newton_offset,
     segment_end,
 )
 from .rolling_spin_fast import SAMPLE_WORK, TOL_IMPULSE, TOL_PHASE, DryWhirl
@@ -414,8 +416,7 @@ def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, re
     if not K_s > 0.0:
         return None, None
     key, band = level_key(h, Omega), band_of(K_s)
-    tab = prev if isinstance(prev, LevelTable) and prev.key == key and prev.band == band \
-        else None
+    tab = keep if keep is not None and keep.key == key and keep.band == band else None
     if tab is None:
         if limit < TABLE_WORK:
             return None, None
@@ -605,21 +606,13 @@ def _orders(ser: _Series, delta: float, u: float, budget: float) -> int:
 
 
 def _rows(entries: dict[tuple[float, float], complex]) -> tuple[bool, list[Row]]:
-    """``_series``'s rows of the terms c_jl of ``entries``, over psi (one row per j) or over
-    beta (one per l), whichever takes fewer: (over beta, the rows)."""
-    out: tuple[list[Row], list[Row]] = ([], [])
-    for by_beta in (False, True):
-        rows: dict[float, dict[int, complex]] = {}
-        for (j, jp), c in entries.items():
-            outer, inner = (jp, j) if by_beta else (j, jp)
-            rows.setdefault(outer, {})[int(inner)] = c
-        for key, r in sorted(rows.items()):
-            lo, hi = min(r), max(r)
-            vals = [r.get(i, 0j) for i in range(lo, hi + 1)]
-            out[by_beta].append((float(lo), key, vals[-1], vals[-2::-1]) if by_beta
-                                else (key, float(lo), vals[-1], vals[-2::-1]))
-    by_beta = len(out[1]) < len(out[0])
-    return by_beta, out[by_beta]
+    """``_series``'s rows of the terms c_jl of ``entries`` (``dry_whirl_orbit._trimmed``),
+    over psi (one row per j) or over beta (one per l), whichever takes fewer: (over beta,
+    the rows)."""
+    rows = [_trimmed(lambda j, jp: entries.get((j, jp), 0j), 0, by_beta)
+            for by_beta in (False, True)]
+    by_beta = len(rows[1]) < len(rows[0])
+    return by_beta, rows[by_beta]
 
 
 def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_lo: float,
@@ -648,14 +641,7 @@ def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_l
         return r0 + f00 * x + acc * u + 2.0 * (sf.at(b_s + rho1 * sig * u, psi + sig * u, u)
                                                - s_t0).real
 
-    u = rem * abs(w.Omega0)
-    x = 0.0 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u) - u_lin
-    for _ in range(NEWTON_ITERS):
-        du = residual(x) * w._speed(u_lin + x)
-        x = max(-u_lin, x - du)
-        if tab.kappa * du * du <= math.ulp(u_lin + x):
-            break
-    u = u_lin + x
+    u = u_lin + newton_offset(w, rem, u_lin, residual, tab.kappa)
     sd = _StepSums(tab.D, 0.5, K_s, delta, du_hi, b_d, w.T / tab.cap)
     b_e, p_e = b_s + rho1 * sig * u, psi + sig * u
     P = sd.integral(u) + sd.at(b_e, p_e, u) - sd.at(b_s, psi, 0.0)

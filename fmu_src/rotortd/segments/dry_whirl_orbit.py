@@ -490,19 +490,30 @@ def _solve(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float
         s_t = _series(orb.A, b_s + rho1 * sig * u, p, cmath.rect(1.0, p))
         return r0 + f00 * x + 2.0 * (s_t - s_t0).real
 
-    u = rem * abs(w.Omega0)  # where beta turns at least once: the mean rate; else the
-    x = 0.0 if u * rho1 > 2.0 * math.pi else rem * w._speed(0.5 * u) - u_lin  # midpoint
-    for _ in range(NEWTON_ITERS):  # t' = F = 1/|Omega|; the error after an update of du is
-        du = residual(x) * w._speed(u_lin + x)  # at most kappa/2 du^2 (kappa >= |F'/F|)
-        x = max(-u_lin, x - du)
-        if orb.kappa * du * du <= math.ulp(u_lin + x):
-            break
+    x = newton_offset(w, rem, u_lin, residual, orb.kappa)
     u = u_lin + x
     b, p = b_s + rho1 * sig * u, psi + sig * u
     z = cmath.rect(1.0, p)
     P = _series(orb.B, b, p, z) - _series(orb.B, b_s, psi, z0)
     int_n = _series(orb.C, b, p, z) - _series(orb.C, b_s, psi, z0) if w.akcr else 0j
     return x, P, int_n
+
+
+def newton_offset(w: DryWhirl, rem: float, u_lin: float, residual: Any, kappa: float
+                  ) -> float:
+    """x = u - u_lin (rad of psi) with t(u) = rem (s), by Newton on ``residual(x)`` =
+    t(u_lin + x) - rem: started at the mean rate where beta turns at least once in rem,
+    else at the speed at the middle; t' = F = 1/|Omega| from ``w``'s energy integral, and
+    stopped once the update du left kappa du^2 <= ulp(u) (kappa >= |F'/F|: the error after
+    an update of du is at most kappa/2 du^2)."""
+    u = rem * abs(w.Omega0)
+    x = 0.0 if u * (1.0 + w.rho) > 2.0 * math.pi else rem * w._speed(0.5 * u) - u_lin
+    for _ in range(NEWTON_ITERS):
+        du = residual(x) * w._speed(u_lin + x)
+        x = max(-u_lin, x - du)
+        if kappa * du * du <= math.ulp(u_lin + x):
+            break
+    return x
 
 
 def _step(orb: Orbit, w: DryWhirl, theta: float, psi: float, rem: float, work: int,

@@ -76,11 +76,11 @@ N_GRID = 13
 K_MAX = 5
 """Harmonics in beta kept (|j| <= K_MAX); +-(K_MAX + 1) are computed as the check."""
 P_DIRECT = 20
+"""Chebyshev nodes along the path in the direct mode."""
 P_DIRECT_FEW = ((0.5, 10), (1.5, 14))
 """Fewer nodes first where theta turns little over the panel (up to 0.5 rad: 10 nodes, up
 to 1.5 rad: 14), their Chebyshev tails checked as P_DIRECT's; P_DIRECT where they do not
 meet the tolerance (16 nodes do not at 3.4 rad: measured, not kept)."""
-"""Chebyshev nodes along the path in the direct mode."""
 BETA_DIRECT = 4.0
 """Largest turn of the contact angle theta (rad) over a panel of the direct mode."""
 L_MAX = 1.0
