@@ -296,7 +296,8 @@ MUTANTS: tuple[Mutant, ...] = (
       "of the level's polynomial in s dropped)",
       "            return n - 1", "            return 0", ("tests/test_dry_whirl_driven.py",)),
     M("DW2", "dry whirl level table", "the Levin terms m >= 1 all of one sign",
-      "(-1.0 if m % 2 else 1.0) * math.perm(q + m, m)", "1.0 * math.perm(q + m, m)",
+      "(-1.0 if g[1] % 2 else 1.0) * math.perm(q + g[1], g[1])",
+      "1.0 * math.perm(q + g[1], g[1])",
       ("tests/test_dry_whirl_driven.py",)),
     M("DW3", "dry whirl level table", "the table also at the direct panel's steps (a turn "
       "of theta below TABLE_TURN)",
