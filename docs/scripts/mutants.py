@@ -292,17 +292,20 @@ MUTANTS: tuple[Mutant, ...] = (
       "        st.orbit_asked = asked", "        st.orbit_asked = False",
       ("tests/test_dry_whirl_orbit.py",)),
     # ---------------------------------------------------------------- dry whirl level table (#26)
-    M("DW1", "dry whirl level table", "the level held at the step's start (the orders n >= 1 "
-      "of the level's polynomial in s dropped)",
-      "            return n - 1", "            return 0", ("tests/test_dry_whirl_driven.py",)),
+    M("DW1", "dry whirl level table", "the level held at the step's start in the periodic "
+      "part's weights (X = 1 + delta u taken as 1)",
+      "        X = 1.0 + self.delta * u", "        X = 1.0", ("tests/test_dry_whirl_driven.py",)),
     M("DW2", "dry whirl level table", "the Levin terms m >= 1 all of one sign",
-      "(-1.0 if g[1] % 2 else 1.0) * math.perm(q + g[1], g[1])",
-      "1.0 * math.perm(q + g[1], g[1])",
+      "(-1.0) ** m * math.prod(p0 - k - i for i in range(m))",
+      "math.prod(p0 - k - i for i in range(m))",
       ("tests/test_dry_whirl_driven.py",)),
     M("DW3", "dry whirl level table", "the table also at the direct panel's steps (a turn "
       "of theta below TABLE_TURN)",
       "    if L is not None and w.rho * L <= TABLE_TURN:",
       "    if L is not None and w.rho * L <= -1.0:", ("tests/test_dry_whirl_driven.py",)),
+    M("DW4", "dry whirl level table", "the mean's change with the level dropped (its "
+      "integral taken at the step's start level)",
+      "        return acc * u", "        return 0.0 * acc", ("tests/test_dry_whirl_driven.py",)),
 )
 
 

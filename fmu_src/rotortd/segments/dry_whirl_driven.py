@@ -19,26 +19,28 @@ K moves with u; the integrands are explicit functions of it (x = 2 V_p/K, |x| <=
 Omega^2, the rolling forces being linear in Omega^2). So every harmonic of F and D on the
 torus (beta, psi) is c_jl(K) = sum_k a_jlk K^(p0 - k), with a table a_jlk fixed by the rotor
 and the held inputs (``LevelTable``: 2-D DFTs on the orbit's grid, once per band of levels).
-Within a step K = K_s (1 + delta s), delta = 2 T sigma/K_s, and
+Within a step K = K_s X, X = 1 + delta s, delta = 2 T sigma/K_s, and
 
-    c_jl(s) = sum_n c_jl^n s^n,   c_jl^n = delta^n sum_k a_jlk K_s^(p0-k) C(p0 - k, n),
+    c_jl(s) = sum_k a_jlk K_s^(p0-k) X^(p0-k),   d^m/ds^m X^a = (a)_m delta^m X^(a-m),
 
-so each harmonic is a polynomial in s times e^{i phi_jl(s)}, integrated in closed form
-(int_0^u P(s) e^{i omega s} ds = [Y(s) e^{i omega s}]_0^u, Y = sum_m (-1)^m P^(m)/(i omega)^(m+1),
-omega = sigma w_jl, |w_jl| >= 1). Summed over the harmonics this is sum_km w_km(u) S_km with
-fixed 2-D sums S_km = sum_jl a_jlk/(i omega)^(m+1) e^{i (j beta + l psi)} (``_Series``,
-built once per table) and scalar weights w_km(u), polynomials in u from K_s and delta
-(``_StepSums``): a step rebuilds no coefficient. It is Newton on these sums (as
-``dry_whirl_orbit._solve``) and the impulse sums at both ends: its work follows the number of
-terms, which falls with the speed (eps = 2 V_b/K). The table takes a step only where the
-panel's turn of theta is above TABLE_TURN: below it the direct panel of ``rolling_spin_fast``
-costs less (docs/notes/dry-whirl-quadrature.md §10).
+((a)_m the falling factorial), so each term is a power of X times e^{i phi_jl(s)}, integrated
+by parts (Levin's form: int_0^u P(s) e^{i omega s} ds = [Y(s) e^{i omega s}]_0^u + R,
+Y = sum_(m <= M) (-1)^m P^(m)/(i omega)^(m+1), R the remainder with P^(M+1), omega =
+sigma w_jl, |w_jl| >= 1), every derivative in closed form. Summed over the harmonics this
+is sum_km w_km(u) S_km with fixed 2-D sums S_km = sum_jl a_jlk/(i omega)^(m+1)
+e^{i (j beta + l psi)} (``_Series``, built once per table) and scalar weights
+w_km(u) = (-1)^m (p0 - k)_m delta^m K_s^(p0-k) X^(p0-k-m) (``_StepSums``): a step rebuilds
+no coefficient, and the level's change within it is exact (no expansion in s). It is
+Newton on these sums (as ``dry_whirl_orbit._solve``) and the impulse sums at both ends: its
+work follows the number of terms, which falls with the speed (eps = 2 V_b/K). The table
+takes a step only where the panel's turn of theta is above TABLE_TURN: below it the direct
+panel of ``rolling_spin_fast`` costs less (docs/notes/dry-whirl-quadrature.md §10).
 
 Errors (estimated, as ``dry_whirl_orbit``): the check harmonics (+-(K + 1)), the table terms
 left out (smallest first, TRIM_SHARE of the tolerance) and the orders k beyond the table's (the
 binomial tail, bounded by eps^(k+1)/(1 - eps)), each at its largest over the band, within
-LEVEL_SHARE of the step's tolerance; the orders n left out within ORDER_SHARE, the Levin
-terms m >= 1 left out within M_SHARE. Events:
+LEVEL_SHARE of the step's tolerance; the Levin terms m >= 1 left out and the remainders
+beyond N_ORDERS within M_SHARE. Events:
 ``DryWhirl._no_event`` over the whole torus and every Omega^2 the band allows, once per
 table. Where anything fails (the band's eps too large, an event not excluded, the step
 leaving the band, the bearing's spring on: a k != 0) ``advance`` declines and the panels of
@@ -55,7 +57,6 @@ from __future__ import annotations
 import cmath
 import math
 from dataclasses import replace
-from operator import mul
 from typing import TYPE_CHECKING, Any
 
 from .dry_whirl_orbit import (
@@ -108,15 +109,12 @@ TRIM_SHARE = 0.3
 per radian of psi (TOL_PHASE of the mean of F, TOL_IMPULSE of the mean of D)."""
 LEVEL_SHARE = 0.9
 """The share of the step's tolerance that the table's left-out parts may take."""
-ORDER_SHARE = 0.05
-"""The share of the step's tolerance that the orders n of the level's polynomial in s left
-out may take."""
 M_SHARE = 0.05
 """The share of the step's tolerance that the Levin terms m >= 1 left out may take
 (``_Series``)."""
 N_ORDERS = 10
-"""Most degrees n of the polynomials in s (the relative change of K over a step,
-|delta| u, is then at most ORDER_DELTA)."""
+"""Most Levin orders m of a term (``_terms``): beyond, Levin's remainder is bounded (a
+table whose remainders exceed their budget is not ``ok``)."""
 ORDER_DELTA = 0.01
 """Largest relative change of the level over a step taken here."""
 T_PROBE = 2.0 ** 30
@@ -131,18 +129,6 @@ STEP_WORK = SAMPLE_WORK * (2 * NEWTON_ITERS + 5)
 Harmonic = tuple[float, float, list[complex], complex]
 """One harmonic of a table: (j, l, its coefficients a_jlk/(i sigma w_jl) for every order k,
 zero where left out, 1/(i sigma w_jl))."""
-
-
-def _binomials(p0: float, k_max: int) -> list[list[float]]:
-    """C(p0 - k, n) for k = 0..k_max, n = 0..2 N_ORDERS (generalised binomials)."""
-    out = []
-    for k in range(k_max + 1):
-        row, c = [], 1.0
-        for n in range(2 * N_ORDERS + 1):
-            row.append(c)
-            c *= (p0 - k - n) / (n + 1)
-        out.append(row)
-    return out
 
 
 def _series_b(inverse: bool, k_max: int) -> list[float]:
@@ -211,7 +197,6 @@ class LevelTable:
             return
         self.k_max = k_max
         fs, ds, dts = self._grid(w, k_max)
-        self.bf, self.bd = _binomials(-0.5, k_max), _binomials(0.5, k_max + 1)
         self._tables(w, [_dft2(x) for x in fs], [_dft2(x) for x in ds],
                      [_dft2(x) for x in dts], tail)
 
@@ -277,8 +262,8 @@ class LevelTable:
     def _tables(self, w: DryWhirl, cf: list[dict[tuple[int, int], complex]],
                 cd: list[dict[tuple[int, int], complex]],
                 ct: list[dict[tuple[int, int], complex]], tail: float) -> None:
-        """The harmonics kept (``Harmonic``), their magnitude bounds over the band sorted
-        largest first (for ``_orders``), the means and the error bounds."""
+        """The harmonics kept (``Harmonic``), the series, the means and the error
+        bounds."""
         rho1, sig = 1.0 + w.rho, w.sig
         lo_hi = (self.K_lo, self.K_hi)
 
@@ -296,27 +281,25 @@ class LevelTable:
         k1, jp1 = K_BETA + 1, K_PSI + 1
         err_t = [0.0, 0.0, tail * self.mean_f]  # (the binomial tail: slow)
         err_d = [0.0, 0.0, tail * self.d_scale]
-        hf, m_f = self._kept(cf, -0.5, True, TRIM_SHARE * TOL_PHASE * f_min, err_t,
+        hf = self._kept(cf, -0.5, True, TRIM_SHARE * TOL_PHASE * f_min, err_t,
                              rho1, sig, top)
-        hd, m_d = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
+        hd = self._kept(cd, 0.5, False, TRIM_SHARE * TOL_IMPULSE * self.d00_min,
                              err_d, rho1, sig, top)
-        ht, m_t = self._kept(ct, 0.5, False, 0.5 * TRIM_SHARE * TOL_IMPULSE * self.d00_min,
+        ht = self._kept(ct, 0.5, False, 0.5 * TRIM_SHARE * TOL_IMPULSE * self.d00_min,
                              err_d, rho1, sig, top)
         delta_max = 2.0 * abs(w.T) / self.K_lo
         self.du_min = 0.5 * TABLE_TURN / w.rho * self.w_min / self.w_max
         tol_t = TOL_PHASE / (w.rho * self.w_max)  # (s: TOL_PHASE rad of theta)
-        self.F = _Series((hf, m_f, f00, self.mean_f,
+        self.F = _Series((hf, f00,
                           (0.5 * M_SHARE * tol_t / 4.0,  # (t: 2 Re, 2 ends)
                            0.5 * M_SHARE * TOL_PHASE / (2.0 * self.w_max))),
-                         -0.5, self.bf,
-                         [max(K ** (-0.5 - k) for K in lo_hi) for k in range(len(self.bf))],
+                         -0.5, [max(K ** (-0.5 - k) for K in lo_hi) for k in range(len(f00))],
                          delta_max)
-        scale_d = [max(K ** (0.5 - k) for K in lo_hi) for k in range(len(self.bd))]
+        scale_d = [max(K ** (0.5 - k) for K in lo_hi) for k in range(len(d00))]
         budgets_d = (0.5 * M_SHARE * TOL_IMPULSE * self.d00_min * self.du_min / 2.0,
                      0.5 * M_SHARE * TOL_IMPULSE * self.d00_min)
-        self.D = _Series((hd, m_d, d00, self.mean_d, budgets_d), 0.5, self.bd, scale_d,
-                         delta_max, (ht, m_t, t00, top(t00, 0.5),
-                                     (0.5 * budgets_d[0], 0.5 * budgets_d[1])))
+        self.D = _Series((hd, d00, budgets_d), 0.5, scale_d, delta_max,
+                         (ht, t00, (0.5 * budgets_d[0], 0.5 * budgets_d[1])))
         for (j, jp) in ((j, jp) for j in range(-k1, k1 + 1) for jp in range(-jp1, jp1 + 1)):
             if abs(j) == k1 or abs(jp) == jp1:
                 _add(err_t, j, jp, 2.0 * top([c[(j, jp)] for c in cf], -0.5), rho1)
@@ -326,18 +309,18 @@ class LevelTable:
         self.kappa = 0.5 * (w.c2 * rho1 / _i_min(w)
                             + 2.0 * (w.c_r * math.hypot(w.Gx, w.Gy) * w.rho + abs(w.mge)
                                      + abs(w.T)) / (self.K_lo - 2.0 * _v_bound(w)))
-        self.ok = all(map(math.isfinite, (*self.err_t, *self.err_d))) and self.d00_min > 0.0
+        self.ok = (all(map(math.isfinite, (*self.err_t, *self.err_d))) and self.d00_min > 0.0
+                   and self.F.ok and self.D.ok)
 
     @staticmethod
     def _kept(cs: list[dict[tuple[int, int], complex]], p0: float, real: bool, budget: float,
               err: list[float], rho1: float, sig: float, top: Any
-              ) -> tuple[list[Harmonic], list[float]]:
+              ) -> list[Harmonic]:
         """The harmonics kept of a series (for a real one the half j > 0 or j = 0 < l):
         its terms a_jlk, each at its largest over the band, are left out smallest first
         while they sum to at most ``budget`` (doubled for a real series; added to ``err``:
         a left-out term integrates to at most its size times the step's du, the bound
-        the tolerance is checked against); the harmonics sorted by their magnitude over
-        the band, largest first; and those magnitudes."""
+        the tolerance is checked against)."""
         sizes: dict[tuple[int, int], list[float]] = {}
         for j in range(-K_BETA, K_BETA + 1):
             for jp in range(-K_PSI, K_PSI + 1):
@@ -353,17 +336,15 @@ class LevelTable:
             total += size
             left.add(hk)
             _add(err, hk[0][0], hk[0][1], size, rho1)
-        out: list[tuple[float, Harmonic]] = []
+        out: list[Harmonic] = []
         for (j, jp), row in sizes.items():
             keep = [k for k in range(len(row)) if ((j, jp), k) not in left]
             if not keep:
                 continue
             inv = 1.0 / (1j * sig * (j * rho1 + jp))
-            out.append((sum(row[k] for k in keep),
-                        (float(j), float(jp), [v[(j, jp)] * inv if k in keep else 0j
-                                               for k, v in enumerate(cs)], inv)))
-        out.sort(key=lambda e: -e[0])
-        return [h for _, h in out], [m for m, _ in out]
+            out.append((float(j), float(jp), [v[(j, jp)] * inv if k in keep else 0j
+                                              for k, v in enumerate(cs)], inv))
+        return out
 
     def peak_on(self, psi_a: float, psi_b: float, K_a: float, K_b: float, T: float
                 ) -> float:
@@ -429,7 +410,7 @@ def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, re
     if not (tab.K_lo <= K_s - dK and K_s + dK <= tab.K_hi and dK <= ORDER_DELTA * K_s
             and du_lo >= tab.du_min and _within_tolerance(tab, w, du_lo, du_hi)):
         return None, tab
-    return _step(tab, w, psi, rem, K_s, du_lo, du_hi, step0), tab
+    return _step(tab, w, psi, rem, K_s, step0), tab
 
 
 def _within_tolerance(tab: LevelTable, w: DryWhirl, du: float, du_err: float) -> bool:
@@ -462,21 +443,20 @@ class _Series:
     magnitude of the harmonics, the binomials C(p0 - k, n) (row k) and their largest
     modulus per n. ``scale[k]``: the largest K^(p0 - k) over the band."""
 
-    __slots__ = ("bins", "cmax", "facs", "flat", "groups", "left", "m_top", "mean", "mean_t",
-                 "size", "total")
+    __slots__ = ("facs", "flat", "groups", "left", "m_top", "mean", "mean_t", "ok")
 
-    def __init__(self, part: Part, p0: float, bins: list[list[float]], scale: list[float],
-                 delta_max: float, part_t: Part | None = None) -> None:
+    def __init__(self, part: Part, p0: float, scale: list[float], delta_max: float,
+                 part_t: Part | None = None) -> None:
         parts = [part] if part_t is None else [part, part_t]
-        self.mean = part[2]
-        self.mean_t = None if part_t is None else part_t[2]
-        self.size = sum(p[3] for p in parts)
-        self.bins, self.total = bins, sum(sum(p[1]) for p in parts)
-        self.cmax = [max(abs(row[n]) for row in bins) for n in range(N_ORDERS + 1)]
+        self.mean = part[1]
+        self.mean_t = None if part_t is None else part_t[1]
         kept, self.left = [], []
-        for f, (hs, _, _, _, budgets) in enumerate(parts):
-            left = [0.0, 0.0]
-            for t in sorted(_terms(hs, p0, scale, delta_max), key=lambda t: t[0]):
+        self.ok = True
+        for f, (hs, _, budgets) in enumerate(parts):
+            terms = _terms(hs, p0, scale, delta_max)
+            left = [0.0, sum(2.0 * t[0] / t[6] for t in terms if t[1] < 0)]
+            self.ok = self.ok and left[1] <= budgets[1]  # (the remainders beyond N_ORDERS)
+            for t in sorted((t for t in terms if t[1] >= 0), key=lambda t: t[0]):
                 per_rad = 2.0 * t[0] / t[6]
                 if not t[1]:
                     kept.append((f, *t))
@@ -499,21 +479,23 @@ class _Series:
             else:
                 self.groups.append((k, m, f, *_rows(entries)))
         self.m_top = max(g[1] for g in self.groups)
-        self.facs = [[(-1.0 if g[1] % 2 else 1.0) * math.perm(q + g[1], g[1])
-                      for q in range(N_ORDERS + 1)] for g in self.groups]
-        """(-1)^m (q + m)!/q! of each group (``_StepSums``'s weights)."""
+        self.facs = [(-1.0) ** m * math.prod(p0 - k - i for i in range(m))
+                     for k, m, *_ in self.groups]
+        """(-1)^m (p0 - k)_m of each group (k, m), the falling factorial (``_StepSums``'s
+        weights)."""
 
 
-Part = tuple[list[Harmonic], list[float], list[Any], float, tuple[float, float]]
-"""One part of a ``_Series``: its harmonics, their magnitudes, the mean's a_00k, the
-mean's magnitude, and the budgets of its Levin terms m >= 1 left out (at the ends, per
-radian)."""
+Part = tuple[list[Harmonic], list[Any], tuple[float, float]]
+"""One part of a ``_Series``: its harmonics, the mean's a_00k, and the budgets of its Levin
+terms m >= 1 left out (at the ends, per radian)."""
 
 
 def _terms(hs: list[Harmonic], p0: float, scale: list[float], delta_max: float
            ) -> list[tuple[float, int, int, float, float, complex, float]]:
     """Every term (bound of its use, m, k, j, l, coefficient a_jlk/(i w)^(m+1), 1/|w|) of
-    the harmonics hs: m = 0, and m >= 1 while its bound is positive (``_Series``)."""
+    the harmonics hs: m = 0, and m >= 1 while its bound is positive (``_Series``); beyond
+    m = N_ORDERS, Levin's remainder int P^(m+1) e^{i w s} ds/(i w)^(m+1) as a term m = -1
+    (its bound per radian is |w| times the next term's, at most its per_rad)."""
     terms = []
     for j, jp, a, inv in hs:
         w_inv = abs(inv)
@@ -527,54 +509,58 @@ def _terms(hs: list[Harmonic], p0: float, scale: list[float], delta_max: float
                 c *= inv
                 use *= abs(p0 - k - m + 1) * delta_max * w_inv / (1.0 - ORDER_DELTA)
                 terms.append((use / (1.0 - ORDER_DELTA), m, k, j, jp, c, w_inv))
+            if use > 0.0:
+                use *= abs(p0 - k - m) * delta_max * w_inv / (1.0 - ORDER_DELTA)
+                terms.append((use / (1.0 - ORDER_DELTA), -1, k, j, jp, 0j, w_inv))
     return terms
 
 
 class _StepSums:
     """A ``_Series`` at a step's start level K_s (J), delta = 2 T sigma/K_s: each group's
-    weight as a polynomial in u (Levin: int_0^u P(s) e^{i w s} ds = [Y(s) e^{i w s}],
-    Y = sum_m (-1)^m P^(m)/(i w)^(m+1), P(s) = sum_n c^n s^n, c^n = sum_k a_k W_nk,
-    W_nk = delta^n K_s^(p0-k) C(p0 - k, n)), and the mean's integral. ``gain`` = T/cap
-    weights the series' part linear in T_drive; ``budget`` bounds the orders n left out
-    (``_orders``) over a step of at most u_hi rad."""
+    weight in closed form (Levin: int_0^u P(s) e^{i w s} ds = [Y(s) e^{i w s}]_0^u + the
+    remainder of ``_Series``, Y = sum_m (-1)^m P^(m)/(i w)^(m+1), with P(s) = K^(p0 - k) =
+    K_s^(p0 - k) X^(p0 - k), X = 1 + delta s, exactly: P^(m) = (p0 - k)_m delta^m
+    K_s^(p0 - k) X^(p0 - k - m), (a)_m the falling factorial), and the mean's integral in
+    closed form. ``gain`` = T/cap weights the series' part linear in T_drive."""
 
-    __slots__ = ("flat", "items", "mean")
+    __slots__ = ("a", "delta", "e_top", "flat", "items", "mean", "mean0", "p0")
 
-    def __init__(self, ser: _Series, p0: float, K_s: float, delta: float, u_hi: float,
-                 budget: float, gain: float = 0.0) -> None:
-        bins = ser.bins
+    def __init__(self, ser: _Series, p0: float, K_s: float, delta: float,
+                 gain: float = 0.0) -> None:
         P = [K_s ** p0]
         r = 1.0 / K_s
-        for _ in range(len(bins) - 1):
+        for _ in range(len(ser.mean) - 1):
             P.append(P[-1] * r)
-        n_top = _orders(ser, delta, u_hi, budget)
-        Wn = [P]  # Wn[n][k] = delta^n P_k C(p0 - k, n)
-        dn = 1.0
-        for n in range(1, n_top + ser.m_top + 1):
-            dn *= delta
-            Wn.append([pk * row[n] * dn for pk, row in zip(P, bins)])
-        self.mean = [sum(map(mul, ser.mean, Wn[n])) / (n + 1) for n in range(n_top + 1)]
-        if ser.mean_t is not None:  # (D's part linear in T_drive, times gain = T/cap)
-            self.mean = [c + gain * sum(map(mul, ser.mean_t, Wn[n])) / (n + 1)
-                         for n, c in enumerate(self.mean)]
-        qs = range(n_top, -1, -1)
+        dm = [1.0]
+        for _ in range(ser.m_top):
+            dm.append(dm[-1] * delta)
+        mean = ser.mean if ser.mean_t is None else [
+            c + gain * ct for c, ct in zip(ser.mean, ser.mean_t)]
+        self.mean = [c * pk for c, pk in zip(mean, P)]  # (the mean's K^(p0 - k) at K_s)
+        self.mean0 = sum(self.mean)
+        self.p0, self.delta = p0, delta
+        self.a = [p0 - k + 1.0 for k in range(len(P))]
         gains = (1.0, gain)
-        self.items = [([gains[f] * fac[q] * Wn[q + m][k] for q in qs], by_beta, rows)
-                      for (k, m, f, by_beta, rows), fac in zip(ser.groups, ser.facs)]
-        """Each group's weight as a polynomial in u (its coefficients, highest first), its
-        rows' orientation and its rows (none: its terms are in ``flat``)."""
+        self.items = [(gains[f] * fall * P[k] * dm[m], k + m, by_beta, rows)
+                      for (k, m, f, by_beta, rows), fall in zip(ser.groups, ser.facs)]
+        """Each group's weight at X = 1, the power of 1/X it takes beyond X^p0, its rows'
+        orientation and its rows (none: its terms are in ``flat``)."""
+        self.e_top = max(e for _, e, _, _ in self.items)
         self.flat = ser.flat
 
     def at(self, beta: float, psi: float, u: float) -> complex:
         """sum_km w_km(u) S_km(beta, psi): the periodic part's Levin sum at (beta, psi) (rad)
         reached after u (rad)."""
         zs = (cmath.rect(1.0, psi), cmath.rect(1.0, beta))
+        X = 1.0 + self.delta * u
+        pw = [X ** self.p0]
+        r = 1.0 / X
+        for _ in range(self.e_top):
+            pw.append(pw[-1] * r)
         s = 0j
         ws = []
-        for poly, by_beta, rows in self.items:
-            w = 0.0
-            for c in poly:
-                w = w * u + c
+        for g, e, by_beta, rows in self.items:
+            w = g * pw[e]
             ws.append(w)
             if rows:
                 s += w * _series(rows, beta, psi, zs[by_beta])
@@ -582,27 +568,21 @@ class _StepSums:
             s += ws[gi] * c * cmath.rect(1.0, j * beta + jp * psi)
         return s
 
-    def integral(self, u: float) -> Any:
-        """int_0^u of the mean's polynomial."""
-        acc = 0.0 * self.mean[0]
-        for c in reversed(self.mean):
-            acc = (acc + c) * u
-        return acc
-
-
-def _orders(ser: _Series, delta: float, u: float, budget: float) -> int:
-    """The highest order n of the level's polynomial in s kept: what is left of each
-    higher order integrates to at most ``budget`` over u (|c^n| s^n to at most
-    M C_n (|delta| u)^n u for a harmonic of magnitude M over the band, C_n the largest
-    |C(p0 - k, n)|)."""
-    q = abs(delta) * u
-    big = max(ser.total, ser.size)
-    f = u
-    for n in range(1, N_ORDERS + 1):
-        f *= q
-        if big * f * ser.cmax[n] <= budget:
-            return n - 1
-    return N_ORDERS
+    def excess(self, u: float) -> Any:
+        """int_0^u of the mean less mean0 u: sum_k c_k u (E_k - 1), E_k = (X^a_k - 1)/(a_k x),
+        x = delta u, a_k = p0 - k + 1, by expm1/log1p and (X^(a-1) - 1) = (X^a - 1 - x)/X
+        (no cancellation beyond a factor |a_k/(a_k - 1)| <= 3 per order)."""
+        x = self.delta * u
+        if x == 0.0:
+            return 0.0 * self.mean0
+        a = self.a
+        y = math.expm1(a[0] * math.log1p(x))
+        r = 1.0 / (1.0 + x)
+        acc = 0.0 * self.mean0
+        for c, ak in zip(self.mean, a):
+            acc += c * (y / (ak * x) - 1.0)
+            y = (y - x) * r
+        return acc * u
 
 
 def _rows(entries: dict[tuple[float, float], complex]) -> tuple[bool, list[Row]]:
@@ -615,36 +595,28 @@ def _rows(entries: dict[tuple[float, float], complex]) -> tuple[bool, list[Row]]
     return by_beta, rows[by_beta]
 
 
-def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, du_lo: float,
-          du_hi: float, step0: float) -> SegmentEnd:
+def _step(tab: LevelTable, w: DryWhirl, psi: float, rem: float, K_s: float, step0: float
+          ) -> SegmentEnd:
     """The end of rem (s) of rolling from ``w``'s start at the level K_s (J): Newton on
     t(u) = rem (t' = F on the path), then the impulse's sums at both ends."""
     sig, rho1 = w.sig, 1.0 + w.rho
     delta = 2.0 * w.T * sig / K_s
-    b_t = ORDER_SHARE * TOL_PHASE / (2.0 * w.rho * tab.w_max)
-    b_d = ORDER_SHARE * TOL_IMPULSE * tab.d00_min * du_lo
-    # (the budgets of the orders left out: time (s), t being twice the real part of its
-    # sum, and impulse (N s), at the least u of the step)
-    sf = _StepSums(tab.F, -0.5, K_s, delta, du_hi, b_t)
+    sf = _StepSums(tab.F, -0.5, K_s, delta)
     b_s = psi + w.phi - w.theta0
     s_t0 = sf.at(b_s, psi, 0.0)
-    f00 = sf.mean[0]
+    f00 = sf.mean0
     u_lin = rem / f00
     r0 = f00 * u_lin - rem
-    hi_mean = sf.mean[1:]
 
     def residual(x: float) -> float:  # t(u_lin + x) - rem
         u = u_lin + x
-        acc = 0.0
-        for c in reversed(hi_mean):
-            acc = (acc + c) * u
-        return r0 + f00 * x + acc * u + 2.0 * (sf.at(b_s + rho1 * sig * u, psi + sig * u, u)
-                                               - s_t0).real
+        return r0 + f00 * x + sf.excess(u) + 2.0 * (
+            sf.at(b_s + rho1 * sig * u, psi + sig * u, u) - s_t0).real
 
     u = u_lin + newton_offset(w, rem, u_lin, residual, tab.kappa)
-    sd = _StepSums(tab.D, 0.5, K_s, delta, du_hi, b_d, w.T / tab.cap)
+    sd = _StepSums(tab.D, 0.5, K_s, delta, w.T / tab.cap)
     b_e, p_e = b_s + rho1 * sig * u, psi + sig * u
-    P = sd.integral(u) + sd.at(b_e, p_e, u) - sd.at(b_s, psi, 0.0)
+    P = sd.mean0 * u + sd.excess(u) + sd.at(b_e, p_e, u) - sd.at(b_s, psi, 0.0)
     K_e = K_s + 2.0 * w.T * sig * u
 
     def peak_on(psi_a: float, psi_b: float) -> float:
