@@ -383,10 +383,10 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
     qzs, qvs = co.qzs, co.qvs
     bz, bv, b0, bE = core._imb_free
     dpsi, iW, c_r, den, RW = W * h, 1j * W, p.c_r, p.c_r * W, p.R * W
-    bias, c, k, a = core._bias_force, complex(p.c), complex(p.k), complex(a)
+    bx, by, c, k = core._bias_force.real, core._bias_force.imag, p.c, p.k
     mode, n_imp, t_last, v_last, E_diss = (core._mode, core._n_impacts, core._t_last,
                                            core._v_last, core._E_diss)  # (fixed in flight)
-    exp, floor, pi, neg_pi = cmath.exp, math.floor, math.pi, -math.pi
+    rect, floor, pi, neg_pi = cmath.rect, math.floor, math.pi, -math.pi
     E_of, E_at, Ec_at = None, 0j, 0j
 
     def lane(core: Any, t_start: float, h_: float) -> QuietStep | None:
@@ -399,7 +399,7 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
         if psi is E_of:  # (the phasor of the last lane step and its conjugate)
             E, Ec = E_at, Ec_at
         else:
-            E = exp(1j * psi)
+            E = rect(1.0, psi)  # (cmath.exp(1j psi)'s bits, without forming 1j psi)
             Ec = E.conjugate()
         g = F1 * E
         z = p11 * z0 + p12 * v0 + fz + g * qzs
@@ -418,13 +418,11 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
         core._z = z
         core._v = v
         core._psi = x
-        E_at = E = exp(1j * x)  # (not kept on the core: a step off the lane computes it)
+        E_at = E = rect(1.0, x)  # (not kept on the core: a step off the lane computes it)
         E_of = x
         Ec_at = rot = E.conjugate()
         U = z * rot
-        dU = (v - iW * z) * rot / den
-        if dU - dU != 0j:
-            dU = 0j
+        dU = (v - iW * z) * rot / den  # (finite: z, v proved bounded, den != 0)
         r = abs(z)
         rr = r * r
         x_ = z.real
@@ -433,10 +431,10 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
         vy = v.imag
         cross = x_ * vy - y_ * vx
         whirl = cross / rr if rr > 0.0 else (cross / r) / r if r > 0.0 else 0.0
-        F = a * (bias - c * v - k * z)
         return (x_, y_, vx, vy, r / c_r, U.real / c_r, U.imag / c_r,
                 dU.real, dU.imag, -x if x == neg_pi else x, whirl, RW + c_r * whirl,
-                F.real, F.imag, W, mode, n_imp, t_last, v_last, E_diss), P / h
+                a * (bx - c * vx - k * x_), a * (by - c * vy - k * y_), W, mode, n_imp,
+                t_last, v_last, E_diss), P / h
 
     lane.h, lane.t_tol = h, t_tol  # type: ignore[attr-defined]
     return lane  # type: ignore[return-value]

@@ -399,11 +399,12 @@ class TouchdownCore(FlightSteps, ContactSteps, SpinSteps, BearingSteps):
         rr = r * r
         whirl = (z.real * v.imag - z.imag * v.real) / rr if rr > 0.0 else (
             ((z.real * v.imag - z.imag * v.real) / r) / r if r > 0.0 else 0.0)
-        F_amb = a * (self._bias_force - p.c * v - p.k * z)  # (RotorParams.amb_force inline)
+        bias, c, k = self._bias_force, p.c, p.k  # (RotorParams.amb_force inline, by parts)
         return (
             z.real, z.imag, v.real, v.imag, r / c_r, U.real / c_r, U.imag / c_r,
             dU.real, dU.imag, -psi if psi == _NEG_PI else psi, whirl,
-            p.R * W + c_r * whirl, F_amb.real, F_amb.imag,
+            p.R * W + c_r * whirl, a * (bias.real - c * v.real - k * z.real),
+            a * (bias.imag - c * v.imag - k * z.imag),
             W, mode, self._n_impacts, self._t_last, self._v_last, self._E_diss,
         )
 
