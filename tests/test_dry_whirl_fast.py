@@ -159,3 +159,20 @@ if __name__ == "__main__":
                          r["P_t"], r["P_c"], mc_)
             print(f"W={W:6.0f} {'levin ' if lv else 'auto  '}"
                   + " ".join(f"{k}={v:.1e}" for k, v in er.items()))
+
+
+def test_a_strong_drive_torque_takes_the_middle_tier_of_direct_nodes() -> None:
+    """100 N m held at 60 rad/s: from this state the 10 Chebyshev nodes miss the impulse's
+    tolerance (theta turns 0.4 rad over the panel); the 14 meet it, and the step matches the
+    40-digit reference (P_DIRECT_FEW's tiers in turn, not 10 then P_DIRECT)."""
+    th, psi, W, T = -1.8, -2.1, 60.0, 100.0
+    w = DryWhirl(HeldInputs(RotorParams(**CHAPTER), J, 0.0, 0j, T), th, psi, W)
+    new = w.advance(H, 10 ** 9)
+    assert new is not None and new.duration == H and new.event is None
+    assert w.samples == 10 + 14
+    ref = mp_contact(CHAPTER, J, 0, th, 0.0, psi, W, H, a=0.0, T_drive=T)
+    assert ref["event"] is None
+    mc = CHAPTER["m"] * CHAPTER["c_r"]
+    err = _errors(new, th, psi, W, ref["theta"], ref["psi"], ref["Omega"], ref["P_n"],
+                  ref["P_t"], ref["P_c"], mc)
+    assert all(v <= TOL for v in err.values()), err

@@ -78,9 +78,11 @@ K_MAX = 5
 P_DIRECT = 20
 """Chebyshev nodes along the path in the direct mode."""
 P_DIRECT_FEW = ((0.5, 10), (1.5, 14))
-"""Fewer nodes first where theta turns little over the panel (up to 0.5 rad: 10 nodes, up
-to 1.5 rad: 14), their Chebyshev tails checked as P_DIRECT's; P_DIRECT where they do not
-meet the tolerance (16 nodes do not at 3.4 rad: measured, not kept)."""
+"""Fewer nodes first where theta turns little over the panel (up to 0.5 rad: 10 nodes, then
+14; up to 1.5 rad: 14), their Chebyshev tails checked as P_DIRECT's; P_DIRECT where they do
+not meet the tolerance (16 nodes do not at 3.4 rad: measured, not kept). A strong drive
+torque can take the 10 nodes past the tolerance at 0.5 rad (100 N m at 60 rad/s on the
+chapter's rotor: one step in three), the 14 then meet it."""
 BETA_DIRECT = 4.0
 """Largest turn of the contact angle theta (rad) over a panel of the direct mode."""
 L_MAX = 1.0
@@ -321,7 +323,7 @@ class DryWhirl:
         ps = (P_CHEB_FINE,) if mod > MOD_FINE else (P_CHEB, P_CHEB_FINE)
         if direct:
             turn = self.rho * L
-            ps = (*[q for top, q in P_DIRECT_FEW if turn <= top][:1], P_DIRECT)
+            ps = (*[q for top, q in P_DIRECT_FEW if turn <= top], P_DIRECT)
         for p in ps:
             Lp = L if direct else max(L, 2.0 * (p + 1) / (1.0 + self.rho))
             if Lp > L_MAX:
