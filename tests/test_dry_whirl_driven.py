@@ -23,6 +23,7 @@ import math
 import random
 from typing import Any
 
+import mpmath as mp
 import pytest
 from rotortd.params import RotorParams
 from rotortd.segments import dry_whirl_driven as driven
@@ -173,3 +174,23 @@ def test_declines_where_it_must() -> None:
     for T in (1e308, -1e308, 5e-324):  # (the level's change too large; a subnormal torque)
         end, _ = _advance(_driven(T), TH0, PSI0, 2000.0, H)
         assert (end is None) == (abs(T) > 1.0)
+
+
+@pytest.mark.parametrize("p0", [-0.5, 0.5])
+def test_the_means_integral_over_a_step_is_the_closed_form(p0: float) -> None:
+    """``_StepSums.excess``: int_0^u sum_k c_k (X^(p0-k) - 1) ds, X = 1 + delta s, against
+    40 digits, for level changes x = delta u from subnormal to 1e-2 of either sign (within
+    1e-15 of sum_k |c_k| u)."""
+    mp.mp.dps = 40
+    sums = driven._StepSums.__new__(driven._StepSums)
+    sums.mean = [1.3, -0.2, 0.05, 0.01, 0.003]
+    sums.a = [p0 - k + 1.0 for k in range(len(sums.mean))]
+    sums.mean0 = sum(sums.mean)
+    u = 0.1
+    for x in (1e-320, 1e-12, 5e-9, 1.5e-8, 1e-5, 1e-3, 1e-2, -5e-9, -1e-3, -1e-2):
+        sums.delta = x / u
+        lx = mp.log1p(mp.mpf(x))  # (X^a - 1 = expm1(a log X): exact for subnormal x too)
+        ref = sum(mp.mpf(c) * u * (mp.expm1(a * lx) / (mp.mpf(a) * mp.mpf(x)) - 1)
+                  for c, a in zip(sums.mean, sums.a))
+        scale = sum(abs(c) for c in sums.mean) * u
+        assert float(abs(sums.excess(u) - ref)) <= 1e-15 * scale, x

@@ -439,9 +439,10 @@ class _Series:
     value at either end (an absolute bound B), the second for their change per radian of
     psi (at most 2 |w| B: the sum's change over a step of du is at most that times du, for
     tolerances that grow with du). ``part_t``: D's part linear in T_drive (cap D_T), its
-    groups weighted by T/cap per step. Also the means' a_00k and magnitudes, the total
-    magnitude of the harmonics, the binomials C(p0 - k, n) (row k) and their largest
-    modulus per n. ``scale[k]``: the largest K^(p0 - k) over the band."""
+    groups weighted by T/cap per step. Also the means' a_00k (``mean``, and ``mean_t`` of
+    D_T), each group's falling factorial (``facs``), and ``ok``: False where Levin's
+    remainders beyond N_ORDERS exceed the per-radian budget. ``scale[k]``: the largest
+    K^(p0 - k) over the band."""
 
     __slots__ = ("facs", "flat", "groups", "left", "m_top", "mean", "mean_t", "ok")
 
@@ -571,11 +572,14 @@ class _StepSums:
     def excess(self, u: float) -> Any:
         """int_0^u of the mean less mean0 u: sum_k c_k u (E_k - 1), E_k = (X^a_k - 1)/(a_k x),
         x = delta u, a_k = p0 - k + 1, by expm1/log1p and (X^(a-1) - 1) = (X^a - 1 - x)/X
-        (no cancellation beyond a factor |a_k/(a_k - 1)| <= 3 per order)."""
+        (no cancellation beyond a factor |a_k/(a_k - 1)| <= 3 per order); below |x| = 1e-8
+        by E_k - 1 = (a_k - 1) x/2 + (a_k - 1)(a_k - 2) x^2/6 (the next term is below 1e-24,
+        and x may be subnormal)."""
         x = self.delta * u
-        if x == 0.0:
-            return 0.0 * self.mean0
         a = self.a
+        if abs(x) < 1e-8:
+            return u * sum(c * ((ak - 1.0) * x * (0.5 + (ak - 2.0) * x / 6.0))
+                           for c, ak in zip(self.mean, a))
         y = math.expm1(a[0] * math.log1p(x))
         r = 1.0 / (1.0 + x)
         acc = 0.0 * self.mean0
