@@ -75,6 +75,22 @@ def test_the_lane_is_the_proved_free_step_and_output_values_to_the_bit() -> None
     assert scenes >= 60 and taken >= 0.8 * 25 * scenes
 
 
+def test_a_tiny_speed_gives_the_lane_a_finite_rate_of_u() -> None:
+    """W = 1e-310 rad/s held: c_r W underflows against v, so dU = (v - i W z) conj(E)/(c_r W)
+    overflows; the lane sets it to 0, as ``output_values`` does, and gives its values."""
+    p = RotorParams()
+    W, h = 1e-310, 1e-3
+    core = TouchdownCore(p, z0=1e-4 + 0j, v0=1e-3j, Omega0=W)
+    for _ in range(3):
+        core.step(h, W)
+    twin = _twin(core, W)
+    quiet = core.quiet_step(h)
+    assert quiet is not None
+    twin.step(h, W)
+    assert quiet[0] == twin.output_values()
+    assert quiet[0][7:9] == (0.0, 0.0)
+
+
 def _in_lane() -> tuple[TouchdownCore, float, float]:
     p = RotorParams(m=50.0, c=2763.0, k=9.8e5, e_c=3e-4, phi=0.21, c_r=7e-4, R=0.04,
                     mu=0.15, d=0.95)

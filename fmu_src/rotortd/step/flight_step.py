@@ -422,7 +422,9 @@ def make_quiet_lane(core: Any, h: float, t_tol: float) -> QuietLane:
         E_of = x
         Ec_at = rot = E.conjugate()
         U = z * rot
-        dU = (v - iW * z) * rot / den  # (finite: z, v proved bounded, den != 0)
+        dU = (v - iW * z) * rot / den
+        if dU - dU != 0j:  # (W != 0 but tiny: c_r W may be too small for v's size)
+            dU = 0j
         r = abs(z)
         rr = r * r
         x_ = z.real

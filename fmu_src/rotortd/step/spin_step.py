@@ -383,9 +383,9 @@ def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
     or a step ``q`` does not prove clear or take."""
     h, p, J, a, F = q.h, q.p, q.J, q.a, q.F_ext
     clear, advance, R0 = q.clear, q.step, p.R * 0.0
-    c_r, R, bias = p.c_r, p.R, p.bias_force
-    c, k, a_c = complex(p.c), complex(p.k), complex(a)  # (the bits of the float products)
-    exp, floor, pi, neg_pi = cmath.exp, math.floor, math.pi, -math.pi
+    c_r, R, c, k = p.c_r, p.R, p.c, p.k
+    bx, by = p.bias_force.real, p.bias_force.imag
+    rect, floor, pi, neg_pi = cmath.rect, math.floor, math.pi, -math.pi
 
     def lane(core: Any, t_start: float, h_: float, T: float) -> QuietStep | None:
         t0 = core._t
@@ -414,7 +414,7 @@ def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
         t = t0 + y
         core._t_lo = (t - t0) - y
         core._t = t
-        core._E_at = E = exp(1j * x)  # (_phasor)
+        core._E_at = E = rect(1.0, x)  # (_phasor: cmath.exp(1j x)'s bits)
         core._E_of = x
         rot = E.conjugate()
         U = z * rot
@@ -427,9 +427,9 @@ def make_spin_quiet_lane(q: QuietSpinStep, t_tol: float) -> SpinQuietLane:
         x_, y_, vx, vy = z.real, z.imag, v.real, v.imag
         cross = x_ * vy - y_ * vx
         whirl = cross / rr if rr > 0.0 else (cross / r) / r if r > 0.0 else 0.0
-        Fa = a_c * (bias - c * v - k * z)
         return (x_, y_, vx, vy, r / c_r, U.real / c_r, U.imag / c_r, dU.real, dU.imag,
-                -x if x == neg_pi else x, whirl, R * W + c_r * whirl, Fa.real, Fa.imag, W,
+                -x if x == neg_pi else x, whirl, R * W + c_r * whirl,
+                a * (bx - c * vx - k * x_), a * (by - c * vy - k * y_), W,
                 0, core._n_impacts, core._t_last, core._v_last, core._E_diss
                 ), (J * (W - W0) - T * h + R0) / h
 
