@@ -73,6 +73,11 @@ OUT_BASE = B.ROOT / "docs" / "bench_instructions_base.json"
 TOLERANCE = 0.02
 """--base: a figure passes if head <= base * (1 + TOLERANCE)."""
 SINGLE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+LAYOUT_PADS = (0, 100, 700, 2000, 5000)
+"""Lengths of a padding variable in a child's environment (``layout_env``): each gives
+another memory layout of the interpreter, under which the same FMU counts up to about 1.5 %
+apart (docs/benchmarks.md, "Quiet steps"); the quiet steps' goals are judged on the counts
+under all of them."""
 ORIGIN = "origin"
 """Extra last argument of the FMU and core children (spelt out in their text): print where
 rotortd came from."""
@@ -217,6 +222,12 @@ Path(sys.argv[3]).write_text(json.dumps({k: str(u) for k, (u, _md) in fmus.items
 
 
 Env = dict[str, str]
+
+
+def layout_env(pad: int) -> Env:
+    """This environment, single-threaded, with a padding variable of ``pad`` characters
+    (``LAYOUT_PADS``)."""
+    return {**os.environ, **SINGLE_THREAD, "BENCH_LAYOUT_PAD": "x" * pad}
 
 
 def instructions(script: Path, *args: str, env: Env | None = None) -> int:

@@ -113,16 +113,27 @@ def quiet_fmu_steps() -> dict[str, Any]:
     """Instructions per 1e-4 s FMU step (callgrind, FMPy's FMU2Slave loop, every output
     read every step) of the quiet spin-state step, RotorTouchdown against the floor FMU
     (benchmarks.py), with the inputs held and with T_drive set by a PI drive before every
-    step; each the difference of a 1100- and a 100-step run, in one run of this script."""
+    step; each the difference of a 1100- and a 100-step run, under each memory layout of
+    ``bench_instructions.LAYOUT_PADS``: the medians, the ratio's range, every layout's."""
     out: dict[str, Any] = {}
     with tempfile.TemporaryDirectory() as tmp:
         count = _fmu_child(Path(tmp), quiet_start_values())
         for drive in ("held", "pi"):
-            fmu, floor = (count(w, drive) for w in ("fmu", "floor"))
-            out[drive] = {"fmu": fmu, "floor": floor, "ratio": fmu / floor, "goal": 1.5}
-            print(f"quiet spin-state step, T_drive {drive:>4s}: RotorTouchdown "
-                  f"{fmu / 1e3:7.1f}k, floor {floor / 1e3:7.1f}k instructions per FMU step, "
-                  f"ratio {fmu / floor:.3f} (goal <= 1.5)", flush=True)
+            lays = []
+            for pad in BI.LAYOUT_PADS:
+                fmu, floor = (count(w, drive, pad) for w in ("fmu", "floor"))
+                lays.append({"pad": pad, "fmu": fmu, "floor": floor, "ratio": fmu / floor})
+                print(f"quiet spin-state step, T_drive {drive:>4s}, layout {pad:5d}: "
+                      f"RotorTouchdown {fmu / 1e3:7.1f}k, floor {floor / 1e3:7.1f}k "
+                      f"instructions per FMU step, ratio {fmu / floor:.3f}", flush=True)
+            ratios = [lay["ratio"] for lay in lays]
+            out[drive] = {"fmu": statistics.median(lay["fmu"] for lay in lays),
+                          "floor": statistics.median(lay["floor"] for lay in lays),
+                          "ratio": statistics.median(ratios), "ratio_min": min(ratios),
+                          "ratio_max": max(ratios), "goal": 1.5, "layouts": lays}
+            print(f"quiet spin-state step, T_drive {drive:>4s}: ratio {out[drive]['ratio']:.3f} "
+                  f"(median of {len(lays)} layouts, {min(ratios):.3f} to {max(ratios):.3f}; "
+                  f"goal <= 1.5)", flush=True)
     return out
 
 
@@ -146,7 +157,8 @@ def _fmu_child(tmp: Path, start: dict[str, Any], steps: tuple[int, int] = (100, 
     for w in ("fmu", "floor"):  # a 0-step run first: the bytecode caches written, so the
         subprocess.run([sys.executable, str(script), str(pkl), w, "held", "0"],  # counted
                        env=env, check=True, capture_output=True)  # runs start alike
-    return lambda which, drive: BI.per_unit(script, [str(pkl), which, drive], *steps, env)
+    return lambda which, drive, pad=0: BI.per_unit(script, [str(pkl), which, drive], *steps,
+                                                   BI.layout_env(pad))
 
 
 def rolling_fmu_steps() -> tuple[float, float]:
@@ -367,7 +379,8 @@ def main() -> int:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--no-valgrind", action="store_true")
     ap.add_argument("--quiet-only", action="store_true",
-                    help="only count the quiet spin-state FMU step (3.), ~5 min")
+                    help="only count the quiet spin-state FMU step (3.) under five memory "
+                         "layouts, ~20 min")
     ap.add_argument("--bearing", action="store_true",
                     help="only the drop onto the real bearing (4.): FMU against the floor "
                          "and the cost against k_c, into the existing file, ~5 min")

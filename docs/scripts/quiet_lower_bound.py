@@ -26,7 +26,8 @@ the floor is a lower bound of the ratio that item 3 can reach. The script first 
 this lean step is the model: after 1000 steps its outputs equal the core's to 1e-12
 relative (the same formulas and the core's own flight map: they differ only by the
 rounding of the terms' order, 1e-16 per step).
-The three FMUs are counted under several memory layouts of the interpreter (``LAYOUT_PADS``:
+The three FMUs are counted under several memory layouts of the interpreter
+(``bench_instructions.LAYOUT_PADS``:
 the same code counts up to about 1 % apart from one to another); prints the counts under
 each, and the medians, the FMU ratio's range and the own work of RotorTouchdown and of the
 lean step; writes docs/quiet_lower_bound.json.
@@ -35,7 +36,6 @@ lean step; writes docs/quiet_lower_bound.json.
 from __future__ import annotations
 
 import json
-import os
 import pickle
 import statistics
 import sys
@@ -169,16 +169,10 @@ def build_lean(tmp: Path, consts: dict[str, Any], start: tuple) -> tuple[str, An
     return extract(str(fmu), str(tmp / "RotorTouchdownLean")), read_model_description(str(fmu))
 
 
-LAYOUT_PADS = (0, 100, 700, 2000, 5000)
-"""Lengths of a padding variable in the children's environment: each is another memory
-layout of the interpreter, under which the same code counts up to about 1 % apart
-(docs/benchmarks.md, "Quiet steps"); the figures are the medians over these layouts."""
-
-
 def count_layout(child: Path, pkl: Path, names: dict[str, str], pad: int) -> dict[str, Any]:
     """The three FMUs' instructions per step under the environment padded by ``pad``
-    characters (``LAYOUT_PADS``)."""
-    env = {**os.environ, **BI.SINGLE_THREAD, "BENCH_LAYOUT_PAD": "x" * pad}
+    characters (``bench_instructions.LAYOUT_PADS``)."""
+    env = BI.layout_env(pad)
     counts = {k: BI.per_unit(child, [str(pkl), k, "free_whirl"], 200, 4200, env)
               for k in names}
     return {"pad": pad, "counts_per_step": counts,
@@ -235,7 +229,7 @@ def main() -> None:
         pkl = tmp / "fmu.pkl"
         pkl.write_bytes(pickle.dumps(data))
         child = BI.write_children(tmp)["fmu"]
-        layouts = [count_layout(child, pkl, names, pad) for pad in LAYOUT_PADS]
+        layouts = [count_layout(child, pkl, names, pad) for pad in BI.LAYOUT_PADS]
     result = summary(layouts, err)
     for lay in layouts:
         c = lay["counts_per_step"]
