@@ -27,10 +27,9 @@ this lean step is the model: after 1000 steps its outputs equal the core's to 1e
 relative (the same formulas and the core's own flight map: they differ only by the
 rounding of the terms' order, 1e-16 per step).
 The three FMUs are counted under several memory layouts of the interpreter
-(``bench_instructions.LAYOUT_PADS``:
-the same code counts up to about 1 % apart from one to another); prints the counts under
-each, and the medians, the FMU ratio's range and the own work of RotorTouchdown and of the
-lean step; writes docs/quiet_lower_bound.json.
+(``bench_instructions.LAYOUT_PADS``: the same code counts up to about 1.5 % apart from one
+to another); prints the counts under each, and the medians, the FMU ratio's range and the
+own work of RotorTouchdown and of the lean step; writes docs/quiet_lower_bound.json.
 """
 
 from __future__ import annotations
