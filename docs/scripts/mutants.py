@@ -453,7 +453,7 @@ def summary(doc: dict[str, Any]) -> str:
         line += f" ({equiv} of the survivors shown equivalent)"
     if "full_run_seconds" in doc:
         line += (f". Full run: {doc['full_run_seconds'] / 60:.0f} min wall time with "
-                 f"--jobs {doc.get('jobs', 1)}")
+                 f"--jobs {doc.get('full_run_jobs', doc.get('jobs', 1))}")
     return line + "."
 
 
@@ -530,9 +530,10 @@ def main(argv: list[str] | None = None) -> int:
                                                            if args.only else ""),
            "wall_seconds": wall, "jobs": args.jobs, "mutants": all_rows}
     if not args.only:
-        doc["full_run_seconds"] = wall
-    elif "full_run_seconds" in previous:
+        doc["full_run_seconds"], doc["full_run_jobs"] = wall, args.jobs
+    elif "full_run_seconds" in previous:  # (a partial run keeps the full run's figures)
         doc["full_run_seconds"] = previous["full_run_seconds"]
+        doc["full_run_jobs"] = previous.get("full_run_jobs", previous.get("jobs", 1))
     args.json.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
     print(table(rows))
     print(f"{len(rows)} mutants in {wall} s wall time "
