@@ -301,8 +301,8 @@ MUTANTS: tuple[Mutant, ...] = (
       ("tests/test_dry_whirl_driven.py",)),
     M("DW3", "dry whirl level table", "the table also at the direct panel's steps (a turn "
       "of theta below TABLE_TURN)",
-      "    if L is not None and w.rho * L <= TABLE_TURN:",
-      "    if L is not None and w.rho * L <= -1.0:", ("tests/test_dry_whirl_driven.py",)),
+      "    if h.p.R / h.p.c_r * rem * abs(Omega) <= TABLE_TURN:",
+      "    if h.p.R / h.p.c_r * rem * abs(Omega) <= -1.0:", ("tests/test_dry_whirl_driven.py",)),
     M("DW4", "dry whirl level table", "the mean's change with the level dropped (its "
       "integral taken at the step's start level)",
       "        return acc * u", "        return 0.0 * acc", ("tests/test_dry_whirl_driven.py",)),

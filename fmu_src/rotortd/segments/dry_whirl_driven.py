@@ -33,8 +33,9 @@ w_km(u) = (-1)^m (p0 - k)_m delta^m K_s^(p0-k) X^(p0-k-m) (``_StepSums``): a ste
 no coefficient, and the level's change within it is exact (no expansion in s). It is
 Newton on these sums (as ``dry_whirl_orbit._solve``) and the impulse sums at both ends: its
 work follows the number of terms, which falls with the speed (eps = 2 V_b/K). The table
-takes a step only where the panel's turn of theta is above TABLE_TURN: below it the direct
-panel of ``rolling_spin_fast`` costs less (docs/notes/dry-whirl-quadrature.md §10).
+takes a step only where theta's turn over it at the start's speed is above TABLE_TURN:
+below it the direct panel of ``rolling_spin_fast`` costs less
+(docs/notes/dry-whirl-quadrature.md §10).
 
 Errors (estimated, as ``dry_whirl_orbit``): the check harmonics (+-(K + 1)), the table terms
 left out (smallest first, TRIM_SHARE of the tolerance) and the orders k beyond the table's (the
@@ -86,10 +87,11 @@ if TYPE_CHECKING:
     from .spin_contact import HeldInputs
 
 TABLE_TURN = 2.0
-"""The table takes a step only where the panel's turn of theta (``DryWhirl.panel_length``
-times rho) is above this (rad): below it the direct panel costs less (measured,
-docs/notes/dry-whirl-quadrature.md §10); the Levin panel's steps (above BETA_DIRECT = 4
-rad) are all the table's."""
+"""The table takes a step only where theta's turn at the start's speed, rho rem |Omega|, is
+above this (rad): below it the direct panel costs less (measured,
+docs/notes/dry-whirl-quadrature.md §10). A choice of cost, not of accuracy, so it is made
+before any ``DryWhirl`` is built; the panels' own choice (direct up to BETA_DIRECT = 4 rad)
+reads the panel's turn, rho ``DryWhirl.panel_length``, which is at least this one."""
 FLAT_BELOW = 4
 """A group of ``_Series`` with fewer terms is summed term by term, not by rows."""
 BAND_LOG2 = 0.25
@@ -386,13 +388,12 @@ def advance(prev: Any, h: HeldInputs, theta: float, psi: float, Omega: float, re
     method does not apply (module docstring): the caller advances the segment otherwise;
     the table is returned all the same, so that a refused one is not rebuilt every step.
     ``prev``: the previous step's table (or ``dry_whirl_orbit.Orbit``, or None)."""
-    w = DryWhirl(h, theta, psi, Omega)
     keep = prev if isinstance(prev, LevelTable) else None
+    if h.p.R / h.p.c_r * rem * abs(Omega) <= TABLE_TURN:
+        return None, keep  # (the direct panel takes it, at less work: §10)
+    w = DryWhirl(h, theta, psi, Omega)
     if not (rem > 0.0 and w.K0 > 0.0 and math.isfinite(w.K0)) or w.rho < RHO_MIN:
         return None, keep
-    L = w.panel_length(rem)
-    if L is not None and w.rho * L <= TABLE_TURN:
-        return None, keep  # (the direct panel takes it, at less work: §10)
     K_s = w.K0 + 2.0 * (w.mge * w.sE0 - w.v0)  # I_P Omega^2 + 2 V_p at the start
     if not K_s > 0.0:
         return None, None
