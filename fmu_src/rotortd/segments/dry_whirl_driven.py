@@ -172,9 +172,9 @@ class LevelTable:
     holds D0 (at T_drive = 0) and cap D_T apart and serves every |T_drive| up to the key's
     cap (``torque_cap``); its bounds (events, the level's rate, Newton's) take the cap."""
 
-    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "bd", "bf", "cap", "d00_min",
-                 "d_scale", "du_min", "err_d", "err_t", "k_max", "kappa", "key", "mean_d",
-                 "mean_f", "n_rising", "n_rows", "ok", "w_max", "w_min")
+    __slots__ = ("D", "F", "K_hi", "K_lo", "band", "cap", "d00_min", "d_scale", "du_min",
+                 "err_d", "err_t", "kappa", "key", "n_rising", "n_rows", "ok", "w_max",
+                 "w_min")
 
     def __init__(self, w: DryWhirl, key: Key, band: int) -> None:
         self.key, self.band, self.ok = key, band, False
@@ -197,7 +197,6 @@ class LevelTable:
             k_max += 1
         if tail > LEVEL_TAIL:
             return
-        self.k_max = k_max
         fs, ds, dts = self._grid(w, k_max)
         self._tables(w, [_dft2(x) for x in fs], [_dft2(x) for x in ds],
                      [_dft2(x) for x in dts], tail)
@@ -279,9 +278,9 @@ class LevelTable:
         self.d00_min = min(abs(sum(v * K ** (0.5 - k) for k, v in enumerate(d00)))
                            - abs(sum(v * K ** (0.5 - k) for k, v in enumerate(t00)))
                            for K in lo_hi)  # (|D0_00 + T D_T,00| for |T| <= cap)
-        self.mean_f, self.mean_d = top(f00, -0.5), top(d00, 0.5)
+
         k1, jp1 = K_BETA + 1, K_PSI + 1
-        err_t = [0.0, 0.0, tail * self.mean_f]  # (the binomial tail: slow)
+        err_t = [0.0, 0.0, tail * top(f00, -0.5)]  # (the binomial tail: slow)
         err_d = [0.0, 0.0, tail * self.d_scale]
         hf = self._kept(cf, -0.5, True, TRIM_SHARE * TOL_PHASE * f_min, err_t,
                              rho1, sig, top)
@@ -441,18 +440,18 @@ class _Series:
     psi (at most 2 |w| B: the sum's change over a step of du is at most that times du, for
     tolerances that grow with du). ``part_t``: D's part linear in T_drive (cap D_T), its
     groups weighted by T/cap per step. Also the means' a_00k (``mean``, and ``mean_t`` of
-    D_T), each group's falling factorial (``facs``), and ``ok``: False where Levin's
-    remainders beyond N_ORDERS exceed the per-radian budget. ``scale[k]``: the largest
-    K^(p0 - k) over the band."""
+    D_T) and their p0 - k + 1 (``a``), each group's falling factorial (``facs``), and
+    ``ok``: False where Levin's remainders beyond N_ORDERS exceed the per-radian budget.
+    ``scale[k]``: the largest K^(p0 - k) over the band."""
 
-    __slots__ = ("facs", "flat", "groups", "left", "m_top", "mean", "mean_t", "ok")
+    __slots__ = ("a", "facs", "flat", "groups", "m_top", "mean", "mean_t", "ok")
 
     def __init__(self, part: Part, p0: float, scale: list[float], delta_max: float,
                  part_t: Part | None = None) -> None:
         parts = [part] if part_t is None else [part, part_t]
         self.mean = part[1]
         self.mean_t = None if part_t is None else part_t[1]
-        kept, self.left = [], []
+        kept = []
         self.ok = True
         for f, (hs, _, budgets) in enumerate(parts):
             terms = _terms(hs, p0, scale, delta_max)
@@ -468,7 +467,6 @@ class _Series:
                     left[1] += per_rad
                 else:
                     kept.append((f, *t))
-            self.left.append(tuple(left))
         by_group: dict[tuple[int, int, int], dict[tuple[float, float], complex]] = {}
         for f, _, m, k, j, jp, c, _ in kept:
             by_group.setdefault((k, m, f), {})[(j, jp)] = c
@@ -481,6 +479,8 @@ class _Series:
             else:
                 self.groups.append((k, m, f, *_rows(entries)))
         self.m_top = max(g[1] for g in self.groups)
+        self.a = [p0 - k + 1.0 for k in range(len(self.mean))]
+        """p0 - k + 1 of each order k of the mean (``_StepSums.excess``)."""
         self.facs = [(-1.0) ** m * math.prod(p0 - k - i for i in range(m))
                      for k, m, *_ in self.groups]
         """(-1)^m (p0 - k)_m of each group (k, m), the falling factorial (``_StepSums``'s
@@ -541,7 +541,7 @@ class _StepSums:
         self.mean = [c * pk for c, pk in zip(mean, P)]  # (the mean's K^(p0 - k) at K_s)
         self.mean0 = sum(self.mean)
         self.p0, self.delta = p0, delta
-        self.a = [p0 - k + 1.0 for k in range(len(P))]
+        self.a = ser.a
         gains = (1.0, gain)
         self.items = [(gains[f] * fall * P[k] * dm[m], k + m, by_beta, rows)
                       for (k, m, f, by_beta, rows), fall in zip(ser.groups, ser.facs)]

@@ -60,7 +60,7 @@ class FlightSteps:
         nothing, which also propagates once from the start. True when taken."""
         fm = self._fm
         psi = self._psi  # (_phasor, inline, storing nothing: in an FMU, output_values
-        E = self._E_at if self._E_of is psi else cmath.exp(1j * psi)  # cached this angle's)
+        E = self._E_at if self._E_of is psi else cmath.rect(1.0, psi)  # cached this angle's)
         work = 1
         if not self._clear:
             if self._on_wall:
@@ -111,11 +111,12 @@ class FlightSteps:
 
     def _phasor(self) -> complex:
         """e^{i psi}, computed once per spin angle: the quiet step and output_values share
-        it. (cmath.exp(1j psi) has the bits of complex(cos psi, sin psi), its real part
-        being exp(+-0) = 1, at half the instructions.)"""
+        it. (cmath.rect(1, psi): complex(cos psi, sin psi), the bits of cmath.exp(1j psi),
+        whose real part is exp(+-0) = 1, without forming 1j psi; the quiet lanes inline
+        it.)"""
         psi = self._psi
         if self._E_of is not psi:
-            self._E_at = cmath.exp(1j * psi)
+            self._E_at = cmath.rect(1.0, psi)
             self._E_of = psi
         return self._E_at
 
